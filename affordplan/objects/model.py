@@ -1,0 +1,233 @@
+"""Object models: a mesh in its centre-of-mass frame, its convex parts, mass and resting states.
+
+``load_object`` accepts a catalogue name, a mesh file (OBJ, STL, PLY, GLB, anything trimesh reads)
+or a ``trimesh.Trimesh``, and normalises it like HACMan: the object frame sits at the centre of mass
+(axes kept from the source), and the mesh is scaled so that its largest half-extent (half the
+longest side of its axis-aligned bounding box in the source frame) equals ``size`` metres.
+
+Real meshes are often not watertight. Such a mesh is repaired by hole filling when that makes it a
+closed volume; otherwise its convex hull stands in for the solid (mass, centre of mass, inertia and
+resting states), and a warning says so. What cannot be made physical raises
+:class:`~affordplan.errors.MeshError`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from affordplan.errors import InputError, MeshError
+from affordplan.objects import decompose, family
+from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states
+from affordplan.objects.shapes import CATALOGUE, Shape
+
+DEFAULT_SIZE = 0.05  # largest half-extent, metres
+DEFAULT_DENSITY = 400.0  # kg/m^3: household objects are partly hollow
+MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb", ".gltf", ".off", ".dae", ".3mf")
+_MIN_RELATIVE_VOLUME = 1e-4  # hull volume / (longest extent)^3 below which a mesh is flat
+
+
+class ObjectModel:
+    """A rigid object ready for simulation and planning.
+
+    Attributes:
+        name: catalogue name, file stem or ``"mesh"``.
+        mesh: the surface, object frame (origin at the centre of mass), metres.
+        parts: convex pieces whose union is the collision shape, object frame.
+        mass: kilograms.
+        inertia: 3x3 inertia tensor about the centre of mass, object frame, kg m^2.
+        hull: convex hull of ``mesh`` (what the object rests on).
+    """
+
+    def __init__(
+        self, name: str, mesh: trimesh.Trimesh, parts: list[trimesh.Trimesh], mass: float,
+        inertia: np.ndarray,
+    ):
+        self.name = name
+        self.mesh = mesh
+        self.parts = tuple(parts)
+        self.mass = float(mass)
+        self.inertia = np.asarray(inertia, dtype=float)
+        self.hull = mesh.convex_hull
+        self._samples: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+
+    def __repr__(self) -> str:
+        return (f"ObjectModel({self.name!r}, extents={np.round(self.mesh.extents, 3).tolist()} m, "
+                f"mass={self.mass:.3f} kg, parts={len(self.parts)})")
+
+    @functools.cached_property
+    def resting_states(self) -> list[RestingState]:
+        """Resting states sorted by probability, most likely first."""
+        states = compute_resting_states(self.hull)
+        if not states:
+            raise MeshError(f"{self.name}: no stable resting pose found")
+        return states
+
+    def classify(self, pose: np.ndarray) -> int:
+        """Resting state of a settled 4x4 world pose, up to yaw."""
+        return classify(self.resting_states, np.asarray(pose)[:3, :3])
+
+    def tilt_from_state(self, pose: np.ndarray, state: int) -> float:
+        """Angle (radians) between a pose's up-vector and the nearest one of ``state``."""
+        return angle_to_state(self.resting_states[state], np.asarray(pose)[:3, :3])
+
+    def surface_samples(self, n: int = 8192, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` points spread over the surface and their outward unit normals, object frame.
+
+        Read-only arrays, computed once per ``(n, seed)`` and kept on the model.
+        """
+        key = (int(n), int(seed))
+        if key not in self._samples:
+            points, face_idx = trimesh.sample.sample_surface_even(self.mesh, n, seed=seed)
+            if len(points) < n:  # sample_surface_even may return fewer; top up uniformly
+                extra, extra_idx = trimesh.sample.sample_surface(self.mesh, n - len(points), seed=seed)
+                points = np.vstack([points, extra])
+                face_idx = np.concatenate([face_idx, extra_idx])
+            normals = np.array(self.mesh.face_normals[face_idx])
+            points.setflags(write=False)
+            normals.setflags(write=False)
+            self._samples[key] = (points, normals)
+        return self._samples[key]
+
+
+def catalogue() -> list[str]:
+    """Names of the built-in objects: the seed paper's seven plus a bowl."""
+    return list(CATALOGUE)
+
+
+def _finish(name: str, mesh: trimesh.Trimesh, solid: trimesh.Trimesh, parts, size: float, density: float):
+    """Move to the centre-of-mass frame, scale, and compute mass properties."""
+    scale = size / (0.5 * float(np.max(mesh.extents)))
+    T = np.eye(4)
+    T[:3, :3] *= scale
+    T[:3, 3] = -scale * solid.center_mass
+    mesh = mesh.copy().apply_transform(T)
+    solid = solid.copy().apply_transform(T)
+    parts = [p.copy().apply_transform(T) for p in parts]
+    mass = density * solid.volume
+    inertia = density * solid.moment_inertia
+    return ObjectModel(name, mesh, parts, mass, inertia)
+
+
+def _from_shape(name: str, shape: Shape, size: float, density: float) -> ObjectModel:
+    return _finish(name, shape.mesh, shape.mesh, shape.parts, size, density)
+
+
+def _read_mesh(path: Path) -> trimesh.Trimesh:
+    if not path.exists():
+        raise MeshError(f"no such mesh file: {path}")
+    if path.stat().st_size == 0:
+        raise MeshError(f"mesh file is empty: {path}")
+    try:
+        loaded = trimesh.load(str(path), force="mesh")
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise MeshError(f"cannot read mesh {path}: {type(exc).__name__}: {exc}") from exc
+    if not isinstance(loaded, trimesh.Trimesh):
+        raise MeshError(f"{path} holds no triangle mesh (got {type(loaded).__name__})")
+    return loaded
+
+
+def _clean(mesh: trimesh.Trimesh, what: str) -> trimesh.Trimesh:
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    faces = np.asarray(mesh.faces)
+    if len(vertices) == 0 or len(faces) == 0:
+        raise MeshError(f"{what} is empty ({len(vertices)} vertices, {len(faces)} faces)")
+    bad = ~np.isfinite(vertices).all(axis=1)
+    if bad.any():
+        raise MeshError(f"{what} has {int(bad.sum())} vertices with NaN or infinite coordinates")
+    if faces.ndim != 2 or faces.shape[1] != 3 or faces.min() < 0 or faces.max() >= len(vertices):
+        raise MeshError(f"{what} has malformed faces")
+    mesh = trimesh.Trimesh(vertices, faces, process=True)
+    mesh.update_faces(mesh.nondegenerate_faces())
+    mesh.remove_unreferenced_vertices()
+    if len(mesh.faces) == 0:
+        raise MeshError(f"{what} has only degenerate faces")
+    return mesh
+
+
+def _solid(mesh: trimesh.Trimesh, what: str) -> tuple[trimesh.Trimesh, bool]:
+    """The closed volume standing for ``mesh``, and whether it is the mesh itself."""
+    try:
+        hull = mesh.convex_hull
+    except Exception as exc:  # qhull fails on flat or collinear input
+        raise MeshError(f"{what} has zero volume (flat or degenerate): {exc}") from exc
+    longest = float(np.max(mesh.extents))
+    if longest <= 0 or hull.volume < _MIN_RELATIVE_VOLUME * longest**3:
+        raise MeshError(f"{what} has zero volume: it is flat or degenerate (extents {mesh.extents})")
+    if not mesh.is_watertight:
+        repaired = mesh.copy()
+        trimesh.repair.fill_holes(repaired)
+        if repaired.is_watertight:
+            mesh = repaired
+            warnings.warn(f"{what} was not watertight; holes were filled", stacklevel=3)
+    if mesh.is_watertight:
+        trimesh.repair.fix_normals(mesh)
+        if mesh.is_volume and mesh.volume > _MIN_RELATIVE_VOLUME * longest**3:
+            return mesh, True
+    warnings.warn(
+        f"{what} is not a closed volume; its convex hull stands in for the solid "
+        "(mass, centre of mass, inertia and resting states)", stacklevel=3,
+    )
+    return hull, False
+
+
+def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float, density: float, what: str) -> ObjectModel:
+    mesh = _clean(mesh, what)
+    solid, closed = _solid(mesh, what)
+    # Decompose in a normalised frame so cache keys do not depend on the source's units.
+    probe = _finish(name, mesh, solid, [], size, density)
+    parts = decompose.convex_parts(probe.mesh, volume=probe.mass / density if closed else None)
+    return ObjectModel(name, probe.mesh, parts, probe.mass, probe.inertia)
+
+
+def _check_size(size: float, density: float) -> None:
+    for label, value in (("size", size), ("density", density)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise InputError(f"{label} must be a positive finite number, got {value!r}")
+
+
+def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_DENSITY) -> ObjectModel:
+    """Load an object and normalise it.
+
+    Args:
+        source: a catalogue name (see :func:`catalogue`), a mesh file path, or a ``trimesh.Trimesh``.
+        size: the largest half-extent after normalisation, metres.
+        density: kg/m^3, for the mass and inertia.
+
+    Raises:
+        MeshError: the source is unknown, unreadable, empty, non-finite or has zero volume.
+    """
+    _check_size(size, density)
+    if isinstance(source, trimesh.Trimesh):
+        return _from_mesh("mesh", source, size, density, "mesh")
+    if isinstance(source, trimesh.Scene):
+        return _from_mesh("mesh", source.to_mesh(), size, density, "scene")
+    if isinstance(source, (str, os.PathLike)):
+        text = os.fspath(source)
+        if text in CATALOGUE:
+            return _from_shape(text, CATALOGUE[text](), size, density)
+        path = Path(text)
+        if path.exists() or path.suffix.lower() in MESH_SUFFIXES:
+            return _from_mesh(path.stem, _read_mesh(path), size, density, f"mesh {path.name}")
+        raise MeshError(f"unknown object {text!r}: not a catalogue name ({', '.join(CATALOGUE)}) "
+                        "and not a mesh file")
+    raise MeshError(f"cannot load an object from {type(source).__name__}")
+
+
+def random_object(
+    index: int, split: str = "train", *, kind: str | None = None, size: float = DEFAULT_SIZE,
+    density: float = DEFAULT_DENSITY,
+) -> ObjectModel:
+    """Object ``index`` of the procedural family's ``split`` ("train" or "test").
+
+    Its largest half-extent is ``size`` times a uniform 0.8-1.2 factor drawn with the object.
+    """
+    _check_size(size, density)
+    chosen, shape, factor = family.random_shape(index, split, kind)
+    return _from_shape(f"{split}_{index}_{chosen}", shape, size * factor, density)

@@ -1,0 +1,164 @@
+"""Resting states: the distinct ways an object can lie still on the table.
+
+``trimesh.poses.compute_stable_poses`` gives one stable pose per hull facet that the centre of mass
+projects into, with its quasi-static probability. Two of them are the same resting state when the
+object-frame "up" vectors agree; a round object's side facets (each a few degrees from the next)
+form a *rolling family* that is one state too. Both cases are one rule: facets whose up-vectors are
+within ``merge_angle`` of each other are linked, and each connected group is a state. With the
+default of 15 deg and 32 facets around round shapes (11.25 deg apart), a cube has 6 states and a
+cylinder 3, while real faces of a polyhedron (>= 20 deg apart in practice) stay apart.
+
+Yaw convention: every state has a ``heading`` (an object-frame unit vector perpendicular to the
+state's up-vector; a rolling family's roll axis). A pose of the state has yaw ``a`` when that
+vector points along ``(cos a, sin a)`` on the table. ``RestingState.rotation`` is the pose at yaw 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import trimesh
+
+from affordplan.geometry import rot_z, yaw_of_direction
+
+DEFAULT_MERGE_ANGLE = math.radians(15.0)
+MIN_PROBABILITY = 0.01  # states rarer than this are dropped; classify maps them to the nearest kept
+
+
+@dataclass(frozen=True)
+class RestingState:
+    """One resting state of an object on the table.
+
+    Attributes:
+        index: position in the object's list (sorted by probability, most likely first).
+        rotation: 3x3 ``R_world_object`` of the most likely member pose at yaw 0.
+        height: the centre of mass above the table in that pose, metres.
+        probability: quasi-static probability of landing in this state (sums to 1 over states).
+        up: object-frame unit vector pointing up in ``rotation``.
+        heading: object-frame unit vector that defines yaw (see the module docstring).
+        member_ups: (k, 3) object-frame up-vectors of every merged stable pose.
+        roll_axis: object-frame unit axis of a rolling family, else ``None``.
+    """
+
+    index: int
+    rotation: np.ndarray
+    height: float
+    probability: float
+    up: np.ndarray
+    heading: np.ndarray
+    member_ups: np.ndarray = field(repr=False)
+    roll_axis: np.ndarray | None = None
+
+    @property
+    def is_rolling_family(self) -> bool:
+        return self.roll_axis is not None
+
+    def yaw_of(self, R_world_object: np.ndarray) -> float:
+        """Yaw (radians) of an orientation of this state."""
+        return yaw_of_direction(R_world_object @ self.heading)
+
+    def pose(self, xy=(0.0, 0.0), yaw: float = 0.0) -> np.ndarray:
+        """4x4 world pose of this state at table position ``xy`` (metres) and ``yaw`` (radians)."""
+        T = np.eye(4)
+        T[:3, :3] = rot_z(yaw) @ self.rotation
+        T[:3, 3] = (xy[0], xy[1], self.height)
+        return T
+
+
+class _UnionFind:
+    def __init__(self, n: int):
+        self.parent = list(range(n))
+
+    def find(self, i: int) -> int:
+        while self.parent[i] != i:
+            self.parent[i] = self.parent[self.parent[i]]
+            i = self.parent[i]
+        return i
+
+    def union(self, i: int, j: int) -> None:
+        self.parent[self.find(i)] = self.find(j)
+
+
+def _heading(up: np.ndarray, roll_axis: np.ndarray | None) -> np.ndarray:
+    if roll_axis is not None:
+        v = roll_axis - np.dot(roll_axis, up) * up
+    else:  # the object axis least aligned with up, made perpendicular to up
+        e = np.eye(3)[int(np.argmin(np.abs(up)))]
+        v = e - np.dot(e, up) * up
+    return v / np.linalg.norm(v)
+
+
+def _roll_axis(ups: np.ndarray) -> np.ndarray | None:
+    """Axis of a rolling family: the normal of the plane (or cone) its up-vectors sweep."""
+    if len(ups) < 3:
+        return None
+    spread = np.degrees(np.arccos(np.clip(ups @ ups.T, -1.0, 1.0))).max()
+    if spread < 30.0:  # a face that compute_stable_poses split in near-duplicates, not a family
+        return None
+    centred = ups - ups.mean(axis=0)
+    axis = np.linalg.svd(centred)[2][-1]
+    sign = 1.0 if axis[int(np.argmax(np.abs(axis)))] > 0 else -1.0
+    return sign * axis / np.linalg.norm(axis)
+
+
+def compute_resting_states(
+    hull: trimesh.Trimesh, merge_angle: float = DEFAULT_MERGE_ANGLE,
+    min_probability: float = MIN_PROBABILITY,
+) -> list[RestingState]:
+    """Resting states of a solid whose centre of mass is at the origin of ``hull``'s frame.
+
+    ``hull`` is the object's convex hull (the object rests on its hull) in the object frame.
+    States whose probability is below ``min_probability`` (a mug balanced on its handle and rim)
+    are dropped and the rest renormalised.
+    """
+    transforms, probs = trimesh.poses.compute_stable_poses(hull, center_mass=np.zeros(3))
+    if len(transforms) == 0:
+        return []
+    ups = np.array([T[:3, :3].T @ np.array([0.0, 0.0, 1.0]) for T in transforms])
+    ups /= np.linalg.norm(ups, axis=1, keepdims=True)
+    uf = _UnionFind(len(ups))
+    cos_merge = math.cos(merge_angle)
+    dots = ups @ ups.T
+    for i, j in zip(*np.nonzero(np.triu(dots >= cos_merge, k=1))):
+        uf.union(int(i), int(j))
+    groups: dict[int, list[int]] = {}
+    for i in range(len(ups)):
+        groups.setdefault(uf.find(i), []).append(i)
+
+    states = []
+    for members in groups.values():
+        members = sorted(members, key=lambda i: -probs[i])
+        best = members[0]
+        member_ups = ups[members]
+        roll_axis = _roll_axis(member_ups)
+        up = ups[best]
+        heading = _heading(up, roll_axis)
+        R = transforms[best][:3, :3]
+        R = rot_z(-yaw_of_direction(R @ heading)) @ R
+        height = float(-(hull.vertices @ R.T)[:, 2].min())
+        states.append(
+            dict(rotation=R, height=height, probability=float(probs[members].sum()), up=up,
+                 heading=heading, member_ups=member_ups, roll_axis=roll_axis)
+        )
+    states.sort(key=lambda s: -s["probability"])
+    states = [s for s in states if s["probability"] >= min_probability] or states[:1]
+    total = sum(s["probability"] for s in states)
+    return [
+        RestingState(index=i, **{**s, "probability": s["probability"] / total})
+        for i, s in enumerate(states)
+    ]
+
+
+def classify(states: list[RestingState], R_world_object: np.ndarray) -> int:
+    """Index of the state whose member up-vectors come closest to the pose's up-vector."""
+    up = np.asarray(R_world_object).T @ np.array([0.0, 0.0, 1.0])
+    best = max(states, key=lambda s: float(np.max(s.member_ups @ up)))
+    return best.index
+
+
+def angle_to_state(state: RestingState, R_world_object: np.ndarray) -> float:
+    """Angle (radians) between a pose's up-vector and the nearest up-vector of ``state``."""
+    up = np.asarray(R_world_object).T @ np.array([0.0, 0.0, 1.0])
+    return float(np.arccos(np.clip(np.max(state.member_ups @ up), -1.0, 1.0)))
