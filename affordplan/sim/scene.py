@@ -1,0 +1,122 @@
+"""MJCF for a table-top scene, generated in code (no asset files).
+
+The scene holds a table plane, the object as one free body whose geoms are its convex parts (mesh
+vertices inlined; the inertia is the true solid's, not the parts' sum), box obstacles, and the
+pusher. Options and contact parameters are the ones DESIGN.md measured to give stable contacts.
+
+Collision filtering (contype / conaffinity): the table collides with the object only; the finger
+collides with the object and obstacles but not the table (its targets are clamped above it).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from affordplan.objects.model import ObjectModel
+from affordplan.world import Box
+
+OBJECT_BODY = "object"
+FINGER_BODY = "finger"
+FINGER_TARGET = "finger_target"
+FINGER_RADIUS = 0.008  # metres
+FINGER_LENGTH = 0.08  # metres, cylinder part of the capsule above the tip
+PARK_POSITION = (0.15, 0.0, 0.45)  # where the finger waits between primitives, metres
+
+OBJECT_CONTACT = 'condim="6" friction="0.5 0.005 0.002" solref="0.005 1" solimp="0.95 0.99 0.001"'
+
+
+def _floats(values) -> str:
+    return " ".join(f"{v:.6g}" for v in np.asarray(values, dtype=float).reshape(-1))
+
+
+def _object_xml(obj: ObjectModel) -> tuple[str, str]:
+    assets = []
+    geoms = []
+    for i, part in enumerate(obj.parts):
+        assets.append(f'<mesh name="part{i}" vertex="{_floats(part.vertices)}"/>')
+        geoms.append(
+            f'<geom name="object_part{i}" type="mesh" mesh="part{i}" contype="1" conaffinity="3" '
+            f'group="1" rgba="0.85 0.55 0.2 1" {OBJECT_CONTACT}/>'
+        )
+    I = obj.inertia
+    full = _floats([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])
+    body = (
+        f'<body name="{OBJECT_BODY}" pos="0.5 0 0.2">\n'
+        f'  <freejoint name="object_joint"/>\n'
+        f'  <inertial pos="0 0 0" mass="{obj.mass:.6g}" fullinertia="{full}"/>\n  '
+        + "\n  ".join(geoms)
+        + "\n</body>"
+    )
+    return "\n".join(assets), body
+
+
+def _obstacle_xml(i: int, box: Box) -> str:
+    half = np.asarray(box.size) / 2
+    quat = [math.cos(box.yaw / 2), 0.0, 0.0, math.sin(box.yaw / 2)]
+    return (
+        f'<geom name="obstacle{i}" type="box" size="{_floats(half)}" '
+        f'pos="{_floats([box.center[0], box.center[1], half[2]])}" quat="{_floats(quat)}" '
+        f'contype="1" conaffinity="3" rgba="0.45 0.5 0.6 1" friction="0.5 0.005 0.002"/>'
+    )
+
+
+def _look_at(pos, target) -> str:
+    """MJCF ``xyaxes`` of a camera at ``pos`` looking at ``target`` with world z up in the image."""
+    forward = np.asarray(target, dtype=float) - np.asarray(pos, dtype=float)
+    forward /= np.linalg.norm(forward)
+    x = np.cross(forward, [0.0, 0.0, 1.0])
+    if np.linalg.norm(x) < 1e-6:  # looking straight down: image up is world +x
+        x = np.array([0.0, -1.0, 0.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(x, forward)
+    return _floats(np.concatenate([x, y]))
+
+
+def _finger_xml() -> str:
+    park = _floats(PARK_POSITION)
+    return f"""
+<body name="{FINGER_TARGET}" mocap="true" pos="{park}"/>
+<body name="{FINGER_BODY}" pos="{park}" gravcomp="1">
+  <freejoint name="finger_joint"/>
+  <geom name="finger_tip" type="capsule" fromto="0 0 0 0 0 {FINGER_LENGTH}" size="{FINGER_RADIUS}"
+        mass="0.05" contype="2" conaffinity="0" friction="0.5 0.005 0.002" rgba="0.2 0.2 0.25 1"/>
+</body>"""
+
+
+def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = "finger") -> str:
+    """MJCF text of the scene. ``pusher`` is ``"finger"`` (a mocap-welded fingertip)."""
+    if pusher != "finger":
+        raise ValueError(f"unknown pusher {pusher!r}")
+    assets, body = _object_xml(obj)
+    obstacles_xml = "\n".join(_obstacle_xml(i, b) for i, b in enumerate(obstacles))
+    return f"""<mujoco model="affordplan">
+<compiler angle="radian"/>
+<option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10"/>
+<visual>
+  <global offwidth="1280" offheight="960"/>
+  <quality shadowsize="2048"/>
+</visual>
+<asset>
+  <texture name="grid" type="2d" builtin="checker" rgb1="0.82 0.8 0.76" rgb2="0.76 0.74 0.7"
+           width="512" height="512"/>
+  <material name="table" texture="grid" texrepeat="8 8" reflectance="0.05"/>
+  {assets}
+</asset>
+<worldbody>
+  <light pos="0.5 -0.6 1.5" dir="0 0.4 -1" diffuse="0.8 0.8 0.8" castshadow="true"/>
+  <light pos="0.3 0.6 1.2" dir="0 -0.3 -1" diffuse="0.4 0.4 0.4" castshadow="false"/>
+  <camera name="overview" pos="1.0 -0.55 0.55" xyaxes="{_look_at((1.0, -0.55, 0.55), (0.52, 0.0, 0.03))}"/>
+  <camera name="top" pos="0.52 0 1.3" xyaxes="{_look_at((0.52, 0.0, 1.3), (0.52, 0.0, 0.0))}"/>
+  <geom name="table" type="plane" size="1.5 1.5 0.05" material="table" contype="1" conaffinity="1"
+        friction="0.5 0.005 0.002"/>
+  {obstacles_xml}
+  {body}
+  {_finger_xml() if pusher == "finger" else ""}
+</worldbody>
+<equality>
+  <weld body1="{FINGER_TARGET}" body2="{FINGER_BODY}" solref="0.01 1"/>
+</equality>
+</mujoco>
+"""

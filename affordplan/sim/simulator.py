@@ -1,0 +1,350 @@
+"""The MuJoCo simulator: reset an object, observe it, execute one primitive.
+
+A primitive follows HACMan's protocol (DESIGN.md): the fingertip is placed 4 cm out along the
+contact's outward normal, servoes to 2 cm, then to the contact (the tip's surface touching it); the
+motion is 3 control steps that each move the target by ``motion * 3 cm`` over 0.5 s; the finger
+retracts 5 cm upwards and leaves, and the object settles (until still, at most 2 s).
+
+Physics runs in chunks of ``CHUNK_STEPS`` steps through ``mj_step(..., nstep)``; the pusher target is
+updated and the guards run once per chunk (every 20 ms), so no Python runs per physics step.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+from scipy.spatial import cKDTree
+
+from affordplan.errors import InputError
+from affordplan.geometry import check_pose, make_pose, transform_points
+from affordplan.objects.model import ObjectModel
+from affordplan.sim.guards import GuardLimits, PhysicsGuard
+from affordplan.sim.scene import (
+    FINGER_BODY,
+    FINGER_RADIUS,
+    FINGER_TARGET,
+    OBJECT_BODY,
+    PARK_POSITION,
+    build_mjcf,
+)
+from affordplan.world import Box, Workspace
+
+CHUNK_STEPS = 10  # physics steps between target updates and guard checks (20 ms)
+TABLE_CONTACT_HEIGHT = 0.003  # points lower than this touch the table and are not observed, metres
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """Timing and geometry of one primitive (SI units)."""
+
+    standoff: float = 0.04  # pre-contact distance along the normal
+    mid_standoff: float = 0.02
+    approach_time: float = 0.1  # per approach segment, seconds
+    motion_step: float = 0.03  # target displacement per control step and unit of motion
+    motion_steps: int = 3
+    motion_step_time: float = 0.5
+    retract_height: float = 0.05
+    retract_time: float = 0.1
+    settle_time_max: float = 2.0
+    settle_linear_speed: float = 0.005  # m/s
+    settle_angular_speed: float = 0.05  # rad/s
+    settle_chunks: int = 5  # consecutive still chunks that count as settled
+    approach_position_tolerance: float = 0.02
+    approach_tilt_tolerance: float = math.radians(5.0)
+    approach_disturbance: float = 0.005  # object displacement before contact that fails approach
+    approach_disturbance_angle: float = math.radians(3.0)
+
+
+@dataclass
+class Outcome:
+    """What one primitive did.
+
+    Attributes:
+        pose_before, pose_after: object 4x4 world poses before the approach and after settling.
+        n_steps: physics steps simulated.
+        approach_ok: the fingertip reached the contact without disturbing the object first.
+        valid: no physics guard fired (see :mod:`affordplan.sim.guards`).
+        tracking_error_max: largest tip-to-target distance during the motion, metres.
+        invalid_reason: name of the guard that fired, if any.
+        contact, normal, motion: the action as executed (world frame; motion clipped to [-1, 1]).
+        success: set by skills that judge the outcome; ``None`` here.
+    """
+
+    pose_before: np.ndarray
+    pose_after: np.ndarray
+    n_steps: int
+    approach_ok: bool
+    valid: bool
+    tracking_error_max: float
+    invalid_reason: str | None = None
+    contact: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    normal: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    motion: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    success: bool | None = None
+
+
+class _Abort(Exception):
+    """Internal: a guard fired; carries its reason."""
+
+
+class Simulator:
+    """A table-top MuJoCo scene with one object, optional box obstacles and a pusher.
+
+    Args:
+        obj: the object to simulate.
+        obstacles: boxes standing on the table.
+        pusher: ``"finger"`` (a fingertip welded to a mocap body; fast, for training).
+        seed: seeds the point-cloud sampling; physics itself is deterministic.
+        workspace: where objects live; the guards allow a margin around it.
+    """
+
+    def __init__(
+        self, obj: ObjectModel, obstacles=(), pusher: str = "finger", seed: int = 0,
+        workspace: Workspace = Workspace(), protocol: Protocol = Protocol(),
+        guard_limits: GuardLimits = GuardLimits(),
+    ):
+        if pusher != "finger":
+            raise InputError(f"unknown pusher {pusher!r}; this version supports 'finger'")
+        self.obj = obj
+        self.obstacles: tuple[Box, ...] = tuple(obstacles)
+        self.pusher = pusher
+        self.workspace = workspace
+        self.protocol = protocol
+        self.model = mujoco.MjModel.from_xml_string(build_mjcf(obj, self.obstacles, pusher))
+        self.data = mujoco.MjData(self.model)
+        self._rng = np.random.default_rng(seed)
+        m = self.model
+        self._object_body = m.body(OBJECT_BODY).id
+        self._object_qpos = int(m.jnt_qposadr[m.body_jntadr[self._object_body]])
+        self._object_qvel = int(m.jnt_dofadr[m.body_jntadr[self._object_body]])
+        self._finger_body = m.body(FINGER_BODY).id
+        self._finger_qpos = int(m.jnt_qposadr[m.body_jntadr[self._finger_body]])
+        self._finger_qvel = int(m.jnt_dofadr[m.body_jntadr[self._finger_body]])
+        self._mocap = int(m.body_mocapid[m.body(FINGER_TARGET).id])
+        self._finger_geom = m.geom("finger_tip").id
+        hull = obj.hull.vertices
+        step = max(1, len(hull) // 256)
+        self._guard = PhysicsGuard(m, self.data, self._object_body, hull[::step], workspace, guard_limits)
+        self._samples_obj, self._normals_obj = obj.surface_samples()
+        self._kdtree = cKDTree(self._samples_obj)
+        self.physics_time = 0.0  # seconds spent inside mj_step, for benchmarks
+        self.physics_steps = 0
+        self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self, resting_state: int = 0, xy=(0.5, 0.0), yaw: float = 0.0) -> np.ndarray:
+        """Place the object in ``resting_state`` at ``xy`` (metres) and ``yaw`` (radians), let it settle.
+
+        Returns the settled 4x4 world pose.
+        """
+        n = len(self.obj.resting_states)
+        if not isinstance(resting_state, (int, np.integer)) or not 0 <= resting_state < n:
+            raise InputError(f"resting_state must be an integer in [0, {n}), got {resting_state!r}")
+        xy = np.asarray(xy, dtype=float)
+        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not math.isfinite(yaw):
+            raise InputError(f"xy must be 2 finite numbers and yaw finite, got {xy!r}, {yaw!r}")
+        if not self.workspace.contains(xy):
+            raise InputError(f"xy={tuple(xy)} is outside the workspace {self.workspace}")
+        return self.set_object_pose(self.obj.resting_states[int(resting_state)].pose(xy, yaw))
+
+    def set_object_pose(self, T_world_object: np.ndarray, settle: bool = True) -> np.ndarray:
+        """Put the object at a 4x4 world pose (velocities zeroed), optionally let it settle."""
+        T = check_pose(T_world_object, "T_world_object")
+        mujoco.mj_resetData(self.model, self.data)
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
+        self.data.qpos[self._object_qpos:self._object_qpos + 3] = T[:3, 3]
+        self.data.qpos[self._object_qpos + 3:self._object_qpos + 7] = quat
+        self._place_finger(np.asarray(PARK_POSITION))
+        if settle:
+            try:
+                self._guard.arm()
+                self._settle(max_time=0.5)
+            except _Abort:
+                pass
+        return self.object_pose()
+
+    def object_pose(self) -> np.ndarray:
+        """The object's 4x4 world pose ``T_world_object``."""
+        q = self.data.qpos[self._object_qpos:self._object_qpos + 7]
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, q[3:])
+        return make_pose(R.reshape(3, 3), q[:3])
+
+    def point_cloud(self, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` points on the object's surface and their outward normals, world frame.
+
+        Points are drawn (with the simulator's seeded generator) from a fixed, evenly spread sample
+        of the mesh surface; points touching the table are left out. A real depth camera would also
+        miss self-occluded surface, add noise and holes at grazing angles, and see the table and
+        obstacles, which need segmenting out.
+        """
+        if not isinstance(n, (int, np.integer)) or n <= 0:
+            raise InputError(f"n must be a positive integer, got {n!r}")
+        T = self.object_pose()
+        points = transform_points(T, self._samples_obj)
+        normals = self._normals_obj @ T[:3, :3].T
+        visible = np.flatnonzero(points[:, 2] > TABLE_CONTACT_HEIGHT)
+        if len(visible) == 0:
+            visible = np.arange(len(points))
+        idx = self._rng.choice(visible, size=n, replace=len(visible) < n)
+        return points[idx], normals[idx]
+
+    def surface_normal(self, point_world: np.ndarray) -> np.ndarray:
+        """Outward normal (world frame) of the surface sample nearest to ``point_world``."""
+        T = self.object_pose()
+        p_obj = (np.asarray(point_world) - T[:3, 3]) @ T[:3, :3]
+        _, i = self._kdtree.query(p_obj)
+        return T[:3, :3] @ self._normals_obj[i]
+
+    # ------------------------------------------------------------- primitive
+    def execute(self, contact, motion, normal=None) -> Outcome:
+        """Run one primitive: approach ``contact`` (world point, metres), then move by ``motion``.
+
+        ``motion`` is (3,) in [-1, 1] (values beyond are clipped): each of the 3 control steps moves
+        the fingertip target by ``motion * 3 cm``. ``normal`` is the outward surface normal at the
+        contact; by default that of the nearest surface sample.
+        """
+        contact = _vector(contact, "contact")
+        motion = np.clip(_vector(motion, "motion"), -1.0, 1.0)
+        normal = self.surface_normal(contact) if normal is None else _vector(normal, "normal")
+        norm = np.linalg.norm(normal)
+        normal = normal / norm if norm > 1e-9 else np.array([0.0, 0.0, 1.0])
+        p = self.protocol
+        steps0 = self.physics_steps
+        pose_before = self.object_pose()
+        result = dict(approach_ok=False, valid=True, invalid_reason=None, tracking_error_max=0.0)
+        self._guard.arm()
+        try:
+            touch = self._clamp(contact + FINGER_RADIUS * normal)
+            result["approach_ok"] = self._approach(touch, normal, pose_before)
+            if result["approach_ok"]:
+                target = touch
+                for _ in range(p.motion_steps):
+                    nxt = self._clamp(target + p.motion_step * motion)
+                    err = self._servo(target, nxt, p.motion_step_time, track=True)
+                    result["tracking_error_max"] = max(result["tracking_error_max"], err)
+                    target = nxt
+            self._retract()
+            self._settle(p.settle_time_max)
+        except _Abort as abort:
+            result.update(valid=False, invalid_reason=str(abort))
+            self._place_finger(np.asarray(PARK_POSITION))
+        return Outcome(
+            pose_before=pose_before, pose_after=self.object_pose(),
+            n_steps=self.physics_steps - steps0, contact=contact, normal=normal, motion=motion,
+            **result,
+        )
+
+    def _approach(self, touch: np.ndarray, normal: np.ndarray, pose_before: np.ndarray) -> bool:
+        p = self.protocol
+        pre = self._clamp(touch + p.standoff * normal)
+        mid = self._clamp(touch + p.mid_standoff * normal)
+        self._place_finger(pre)
+        if self._finger_penetrates():
+            return False
+        self._servo(pre, mid, p.approach_time)
+        self._servo(mid, touch, p.approach_time)
+        pose = self.object_pose()
+        moved = np.linalg.norm(pose[:3, 3] - pose_before[:3, 3])
+        R = pose[:3, :3] @ pose_before[:3, :3].T
+        turned = math.acos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))
+        tip = self.data.xpos[self._finger_body]
+        axis = self.data.xmat[self._finger_body].reshape(3, 3)[:, 2]
+        tilt = math.acos(np.clip(axis[2], -1.0, 1.0))
+        return bool(
+            np.linalg.norm(tip - touch) <= p.approach_position_tolerance
+            and tilt <= p.approach_tilt_tolerance
+            and moved <= p.approach_disturbance
+            and turned <= p.approach_disturbance_angle
+        )
+
+    def _retract(self) -> None:
+        start = self.data.mocap_pos[self._mocap].copy()
+        self._servo(start, start + np.array([0.0, 0.0, self.protocol.retract_height]), self.protocol.retract_time)
+        self._place_finger(np.asarray(PARK_POSITION))
+
+    def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False) -> float:
+        """Move the finger target linearly from ``start`` to ``end``; return the max tracking error."""
+        n_chunks = max(1, round(duration / (CHUNK_STEPS * self.model.opt.timestep)))
+        worst = 0.0
+        for k in range(1, n_chunks + 1):
+            target = start + (end - start) * (k / n_chunks)
+            self.data.mocap_pos[self._mocap] = target
+            self._step(CHUNK_STEPS)
+            if track:
+                worst = max(worst, float(np.linalg.norm(self.data.xpos[self._finger_body] - target)))
+        return worst
+
+    def _settle(self, max_time: float) -> None:
+        p = self.protocol
+        still = 0
+        for _ in range(max(1, round(max_time / (CHUNK_STEPS * self.model.opt.timestep)))):
+            self._step(CHUNK_STEPS)
+            v = self.data.qvel[self._object_qvel:self._object_qvel + 6]
+            if np.linalg.norm(v[:3]) < p.settle_linear_speed and np.linalg.norm(v[3:]) < p.settle_angular_speed:
+                still += 1
+                if still >= p.settle_chunks:
+                    return
+            else:
+                still = 0
+
+    def _step(self, n: int) -> None:
+        t0 = time.perf_counter()
+        mujoco.mj_step(self.model, self.data, nstep=n)
+        self.physics_time += time.perf_counter() - t0
+        self.physics_steps += n
+        reason = self._guard.check()
+        if reason is not None:
+            raise _Abort(reason)
+
+    # --------------------------------------------------------------- finger
+    def _clamp(self, p: np.ndarray) -> np.ndarray:
+        """Keep the fingertip above the table."""
+        q = np.array(p, dtype=float)
+        q[2] = max(q[2], FINGER_RADIUS + 0.001)
+        return q
+
+    def _place_finger(self, pos: np.ndarray) -> None:
+        """Teleport the finger and its target to ``pos`` at rest."""
+        d = self.data
+        d.mocap_pos[self._mocap] = pos
+        d.qpos[self._finger_qpos:self._finger_qpos + 3] = pos
+        d.qpos[self._finger_qpos + 3:self._finger_qpos + 7] = (1.0, 0.0, 0.0, 0.0)
+        d.qvel[self._finger_qvel:self._finger_qvel + 6] = 0.0
+        mujoco.mj_forward(self.model, d)
+
+    def _finger_penetrates(self, depth: float = 0.001) -> bool:
+        c = self.data.contact
+        if self.data.ncon == 0:
+            return False
+        involved = (c.geom[:, 0] == self._finger_geom) | (c.geom[:, 1] == self._finger_geom)
+        return bool(np.any(involved & (c.dist < -depth)))
+
+    # -------------------------------------------------------------- render
+    def render(self, width: int = 640, height: int = 480, camera: str = "overview") -> np.ndarray:
+        """An RGB image (height, width, 3) of the scene. Headless: set ``MUJOCO_GL=egl``."""
+        key = (int(width), int(height))
+        if key not in self._renderers:
+            self._renderers[key] = mujoco.Renderer(self.model, height=key[1], width=key[0])
+        renderer = self._renderers[key]
+        renderer.update_scene(self.data, camera=camera)
+        return renderer.render()
+
+    def close(self) -> None:
+        """Free rendering contexts."""
+        for r in self._renderers.values():
+            r.close()
+        self._renderers.clear()
+
+
+def _vector(v, name: str) -> np.ndarray:
+    arr = np.asarray(v, dtype=float).reshape(-1)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise InputError(f"{name} must be 3 finite numbers, got {v!r}")
+    return arr
