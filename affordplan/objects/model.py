@@ -154,11 +154,13 @@ def _clean(mesh: trimesh.Trimesh, what: str) -> trimesh.Trimesh:
 def _solid(mesh: trimesh.Trimesh, what: str) -> tuple[trimesh.Trimesh, bool]:
     """The closed volume standing for ``mesh``, and whether it is the mesh itself."""
     try:
-        hull = mesh.convex_hull
+        with np.errstate(invalid="ignore", divide="ignore"):  # flat input: 0/0 in trimesh
+            hull = mesh.convex_hull
+            hull_volume = float(hull.volume)
     except Exception as exc:  # qhull fails on flat or collinear input
         raise MeshError(f"{what} has zero volume (flat or degenerate): {exc}") from exc
     longest = float(np.max(mesh.extents))
-    if longest <= 0 or hull.volume < _MIN_RELATIVE_VOLUME * longest**3:
+    if longest <= 0 or not hull_volume >= _MIN_RELATIVE_VOLUME * longest**3:
         raise MeshError(f"{what} has zero volume: it is flat or degenerate (extents {mesh.extents})")
     if not mesh.is_watertight:
         repaired = mesh.copy()

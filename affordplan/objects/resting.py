@@ -5,8 +5,9 @@ projects into, with its quasi-static probability. Two of them are the same resti
 object-frame "up" vectors agree; a round object's side facets (each a few degrees from the next)
 form a *rolling family* that is one state too. Both cases are one rule: facets whose up-vectors are
 within ``merge_angle`` of each other are linked, and each connected group is a state. With the
-default of 15 deg and 32 facets around round shapes (11.25 deg apart), a cube has 6 states and a
-cylinder 3, while real faces of a polyhedron (>= 20 deg apart in practice) stay apart.
+default of 25 deg, round shapes modelled with 16 or more facets around (22.5 deg apart) form one
+rolling family, so a cylinder has 3 states and a cube 6; faces closer than 25 deg are one state
+(no primitive tells them apart: a roll turns the object by >= 60 deg).
 
 Yaw convention: every state has a ``heading`` (an object-frame unit vector perpendicular to the
 state's up-vector; a rolling family's roll axis). A pose of the state has yaw ``a`` when that
@@ -23,7 +24,7 @@ import trimesh
 
 from affordplan.geometry import rot_z, yaw_of_direction
 
-DEFAULT_MERGE_ANGLE = math.radians(15.0)
+DEFAULT_MERGE_ANGLE = math.radians(25.0)
 MIN_PROBABILITY = 0.01  # states rarer than this are dropped; classify maps them to the nearest kept
 
 

@@ -1,0 +1,68 @@
+"""Physics guards fire on each kind of fault, and not on a sane state."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+import affordplan as ap
+from affordplan.sim.guards import PhysicsGuard
+from affordplan.sim.scene import OBJECT_BODY
+
+
+@pytest.fixture()
+def guarded(cube):
+    sim = ap.Simulator(cube)
+    sim.reset()
+    body = sim.model.body(OBJECT_BODY).id
+    guard = PhysicsGuard(sim.model, sim.data, body, cube.hull.vertices, sim.workspace)
+    guard.arm()
+    return sim, guard
+
+
+def test_sane_resting_state_passes(guarded):
+    sim, guard = guarded
+    assert guard.check() is None
+
+
+def test_nan_state(guarded):
+    sim, guard = guarded
+    sim.data.qvel[2] = np.nan
+    assert guard.check() == "nan"
+
+
+def test_left_workspace(guarded):
+    sim, guard = guarded
+    sim.data.qpos[0] = 1.2
+    assert guard.check() == "left_workspace"
+
+
+def test_absurd_speed(guarded):
+    sim, guard = guarded
+    sim.data.qvel[3] = 100.0  # rad/s
+    assert guard.check() == "speed"
+
+
+def test_sunk_into_table(guarded):
+    sim, guard = guarded
+    sim.data.qpos[2] = 0.03  # the cube's half-height is 5 cm: 2 cm under the table
+    mujoco.mj_kinematics(sim.model, sim.data)
+    assert guard.check() == "sank"
+
+
+def test_unstable_warning(guarded):
+    sim, guard = guarded
+    sim.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number += 1
+    assert guard.check() == "unstable"
+
+
+def test_execute_reports_the_guard(cube):
+    """An object dropped from inside the table is thrown out: the primitive is marked invalid."""
+    sim = ap.Simulator(cube)
+    T = sim.reset()
+    T[2, 3] = -0.02
+    sim.set_object_pose(T, settle=False)
+    out = sim.execute(T[:3, 3] + np.array([-0.05, 0.0, 0.07]), (1.0, 0.0, 0.0))
+    assert not out.valid
+    assert out.invalid_reason in {"sank", "speed", "unstable"}

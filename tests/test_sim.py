@@ -1,0 +1,160 @@
+"""Simulator: physics outcomes of the primitive protocol, determinism, observation, bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+
+import affordplan as ap
+from affordplan.errors import InputError
+from primitives import rewards
+
+
+def face_centre_push(sim: ap.Simulator, obj: ap.ObjectModel, stroke: float) -> ap.Outcome:
+    """Push the -x face centre of a box-like object along +x by ``stroke`` (fraction of 9 cm)."""
+    T0 = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    contact = T0[:3, 3] - np.array([obj.mesh.extents[0] / 2, 0.0, 0.0])
+    return sim.execute(contact, (stroke, 0.0, 0.0))
+
+
+def test_cube_face_push_slides_straight(cube):
+    """A 6 cm stroke on the -x face centre: the cube moves 4-9 cm along +x and turns < 5 deg."""
+    sim = ap.Simulator(cube)
+    out = face_centre_push(sim, cube, stroke=2.0 / 3.0)
+    m = rewards.motion(out.pose_before, out.pose_after)
+    assert out.approach_ok and out.valid
+    assert 0.04 <= m.p[0] <= 0.09
+    assert abs(m.p[1]) < 0.01
+    assert m.theta_deg < 5.0
+    assert rewards.push_success(out.pose_before, out.pose_after)
+    assert out.tracking_error_max < 0.005
+    assert cube.classify(out.pose_after) == cube.classify(out.pose_before)
+
+
+def test_lying_pill_bottle_pushed_across_its_axis_rolls(pill_bottle):
+    sim = ap.Simulator(pill_bottle)
+    state = pill_bottle.resting_states[0]
+    assert state.is_rolling_family  # lying on its side
+    T0 = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    axis = T0[:3, :3] @ state.roll_axis
+    assert abs(axis[0]) > 0.99  # yaw 0 puts the roll axis along world x
+    # Contact on the -y side, above the centre of mass: push along +y.
+    contact = T0[:3, 3] + np.array([0.0, -0.7, 0.7]) * 0.02
+    out = sim.execute(contact, (0.0, 1.0, 0.0))
+    m = rewards.motion(out.pose_before, out.pose_after)
+    assert out.approach_ok and out.valid
+    assert m.theta_deg > 60.0
+    assert m.wz < 0.3  # about a horizontal axis
+    assert rewards.roll_success(out.pose_before, out.pose_after)
+
+
+def test_standing_box_pushed_near_a_corner_turns_about_z(lunch_box):
+    sim = ap.Simulator(lunch_box)
+    T0 = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    hx, hy, _ = lunch_box.mesh.extents / 2
+    contact = T0[:3, 3] + np.array([-hx, 0.8 * hy, 0.0])
+    out = sim.execute(contact, (1.0, 0.0, 0.0))
+    m = rewards.motion(out.pose_before, out.pose_after)
+    assert out.valid
+    assert m.theta_deg > 15.0
+    assert m.wz > 0.95
+    assert m.w[2] < 0  # pushing the +y end forward turns it clockwise seen from above
+    assert lunch_box.classify(out.pose_after) == 0
+
+
+def test_same_seed_same_outcome(cube):
+    results = []
+    for _ in range(2):
+        sim = ap.Simulator(cube, seed=7)
+        sim.reset(resting_state=2, xy=(0.55, 0.05), yaw=0.3)
+        points, _ = sim.point_cloud(64)
+        out = sim.execute(points[5], (0.3, -0.8, 0.1))
+        results.append((points, out.pose_after, out.n_steps))
+    assert np.array_equal(results[0][0], results[1][0])
+    assert np.array_equal(results[0][1], results[1][1])
+    assert results[0][2] == results[1][2]
+
+
+def test_point_cloud_lies_on_the_surface_off_the_table(mug):
+    sim = ap.Simulator(mug, seed=1)
+    T = sim.reset(resting_state=0, xy=(0.45, -0.1), yaw=1.0)
+    points, normals = sim.point_cloud(512)
+    assert points.shape == (512, 3) and normals.shape == (512, 3)
+    assert np.all(points[:, 2] > 0.003)
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
+    local = (points - T[:3, 3]) @ T[:3, :3]
+    _, dist, _ = trimesh.proximity.closest_point(mug.mesh, local)
+    assert dist.max() < 1e-5  # metres
+
+
+def test_reset_puts_the_object_in_the_asked_state_and_place(lunch_box):
+    sim = ap.Simulator(lunch_box)
+    for i in range(len(lunch_box.resting_states)):
+        T = sim.reset(resting_state=i, xy=(0.6, 0.1), yaw=0.5)
+        assert lunch_box.classify(T) == i
+        assert np.allclose(T[:2, 3], (0.6, 0.1), atol=0.005)
+        assert lunch_box.resting_states[i].yaw_of(T[:3, :3]) == pytest.approx(0.5, abs=0.02)
+
+
+def test_approach_into_the_object_is_flagged(cube):
+    """A contact whose standoff lies inside the object cannot be approached cleanly."""
+    sim = ap.Simulator(cube)
+    T0 = sim.reset()
+    out = sim.execute(T0[:3, 3] + np.array([0.03, 0.0, 0.0]), (1.0, 0.0, 0.0), normal=(-1.0, 0.0, 0.0))
+    assert not out.approach_ok
+
+
+def test_object_pushed_off_the_workspace_is_invalid(cube):
+    sim = ap.Simulator(cube, workspace=ap.Workspace(x=(0.45, 0.55), y=(-0.05, 0.05)))
+    T0 = sim.reset(xy=(0.5, 0.0))
+    out = sim.execute(T0[:3, 3] - np.array([0.05, 0.0, 0.0]), (1.0, 0.0, 0.0))
+    # The guard margin is 15 cm around this 10 cm-wide workspace: a 9 cm push stays inside ...
+    assert out.valid
+    far = ap.Simulator(cube, workspace=ap.Workspace(x=(0.45, 0.55), y=(-0.05, 0.05)),
+                       guard_limits=ap.sim.GuardLimits(workspace_margin=0.0))
+    T0 = far.reset(xy=(0.5, 0.0))
+    out = far.execute(T0[:3, 3] - np.array([0.05, 0.0, 0.0]), (1.0, 0.0, 0.0))
+    # ... and with no margin the same push leaves it.
+    assert not out.valid and out.invalid_reason == "left_workspace"
+
+
+def test_obstacle_blocks_the_object(cube):
+    wall = ap.Box(center=(0.59, 0.0), size=(0.02, 0.3, 0.1))
+    sim = ap.Simulator(cube, obstacles=[wall])
+    out = face_centre_push(sim, cube, stroke=1.0)
+    # The cube's +x face starts at 0.55 and the wall at 0.58: it can travel 3 cm at most.
+    assert out.pose_after[0, 3] - out.pose_before[0, 3] < 0.032
+
+
+@pytest.mark.parametrize("contact, motion", [
+    ((np.nan, 0.0, 0.05), (1.0, 0.0, 0.0)),
+    ((0.5, 0.0, 0.05), (np.inf, 0.0, 0.0)),
+    ((0.5, 0.0), (1.0, 0.0, 0.0)),
+])
+def test_bad_action_raises(cube, contact, motion):
+    sim = ap.Simulator(cube)
+    with pytest.raises(InputError):
+        sim.execute(contact, motion)
+
+
+def test_bad_reset_raises(cube):
+    sim = ap.Simulator(cube)
+    with pytest.raises(InputError):
+        sim.reset(resting_state=6)
+    with pytest.raises(InputError):
+        sim.reset(xy=(math.nan, 0.0))
+    with pytest.raises(InputError):
+        sim.reset(xy=(2.0, 0.0))
+    with pytest.raises(InputError):
+        ap.Simulator(cube, pusher="gripper")
+
+
+def test_motion_is_clipped_to_unit_box(cube):
+    sim = ap.Simulator(cube)
+    T0 = sim.reset()
+    out = sim.execute(T0[:3, 3] - np.array([0.05, 0.0, 0.0]), (5.0, 0.0, 0.0))
+    assert np.array_equal(out.motion, [1.0, 0.0, 0.0])
+    assert out.pose_after[0, 3] - T0[0, 3] < 0.1
