@@ -22,7 +22,7 @@ FINGER_BODY = "finger"
 FINGER_TARGET = "finger_target"
 FINGER_RADIUS = 0.008  # metres
 FINGER_LENGTH = 0.08  # metres, cylinder part of the capsule above the tip
-PARK_POSITION = (0.15, 0.0, 0.45)  # where the finger waits between primitives, metres
+PARK_POSITION = (-0.3, 0.0, 0.3)  # where the finger waits between primitives, metres
 
 OBJECT_CONTACT = 'condim="6" friction="0.5 0.005 0.002" solref="0.005 1" solimp="0.95 0.99 0.001"'
 
@@ -107,7 +107,7 @@ def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = 
 <worldbody>
   <light pos="0.5 -0.6 1.5" dir="0 0.4 -1" diffuse="0.8 0.8 0.8" castshadow="true"/>
   <light pos="0.3 0.6 1.2" dir="0 -0.3 -1" diffuse="0.4 0.4 0.4" castshadow="false"/>
-  <camera name="overview" pos="1.0 -0.55 0.55" xyaxes="{_look_at((1.0, -0.55, 0.55), (0.52, 0.0, 0.03))}"/>
+  <camera name="overview" pos="0.82 -0.38 0.36" xyaxes="{_look_at((0.82, -0.38, 0.36), (0.52, 0.0, 0.03))}"/>
   <camera name="top" pos="0.52 0 1.3" xyaxes="{_look_at((0.52, 0.0, 1.3), (0.52, 0.0, 0.0))}"/>
   <geom name="table" type="plane" size="1.5 1.5 0.05" material="table" contype="1" conaffinity="1"
         friction="0.5 0.005 0.002"/>
