@@ -10,10 +10,18 @@ The public surface::
     outcome = sim.execute(points[0], (1.0, 0.0, 0.0))
 """
 
-from affordplan import errors
-from affordplan.objects import ObjectModel, RestingState, catalogue, load_object, random_object
-from affordplan.sim import Outcome, Simulator
-from affordplan.world import Box, Workspace
+import os as _os
+import sys as _sys
+
+# MuJoCo picks its OpenGL backend once, at import. On a Linux machine without a display, GLFW cannot
+# open a context, so default to EGL (headless GPU or Mesa); an explicit MUJOCO_GL always wins.
+if _sys.platform.startswith("linux") and not _os.environ.get("DISPLAY") and "mujoco" not in _sys.modules:
+    _os.environ.setdefault("MUJOCO_GL", "egl")
+
+from affordplan import errors  # noqa: E402
+from affordplan.objects import ObjectModel, RestingState, catalogue, load_object, random_object  # noqa: E402
+from affordplan.sim import Outcome, Simulator  # noqa: E402
+from affordplan.world import Box, Workspace  # noqa: E402
 
 __version__ = "0.1.0"
 

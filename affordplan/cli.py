@@ -2,14 +2,9 @@
 
 from __future__ import annotations
 
-import os
-
-# Headless rendering: MuJoCo picks its OpenGL backend when first imported.
-os.environ.setdefault("MUJOCO_GL", "egl")
-
-import argparse  # noqa: E402
-import json  # noqa: E402
-import sys  # noqa: E402
+import argparse
+import json
+import sys
 
 EXAMPLES = """\
 examples:

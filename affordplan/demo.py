@@ -26,6 +26,7 @@ class ScriptedPrimitive:
     height: float  # contact height as a fraction of the object's height above the table (0..1)
     offset: float  # lateral offset as a fraction of the half-width across the direction (-1..1)
     stroke: float  # motion magnitude in [0, 1]
+    state: int = 0  # resting state to start from
 
 
 def scripted_action(sim: Simulator, p: ScriptedPrimitive, n_points: int = 2048):
@@ -61,7 +62,7 @@ def _describe(out: Outcome) -> dict:
 
 DEMO_PRIMITIVES = (
     ScriptedPrimitive("push", (1.0, 0.0), height=0.45, offset=0.0, stroke=0.8),
-    ScriptedPrimitive("roll", (0.0, 1.0), height=0.95, offset=0.0, stroke=1.0),
+    ScriptedPrimitive("roll", (0.0, 1.0), height=1.0, offset=0.0, stroke=1.0, state=2),  # tip it over
     ScriptedPrimitive("spin", (0.0, 1.0), height=0.45, offset=-0.85, stroke=1.0),
 )
 
@@ -78,16 +79,17 @@ def run_demo(out_dir: str | Path = "affordplan-demo", object_name: str = "mug", 
     echo("resting states: " + ", ".join(
         f"#{s.index} p={s.probability:.2f}{' (rolls)' if s.is_rolling_family else ''}" for s in states))
     sim = Simulator(obj, seed=seed)
+    renderer = _Pictures(sim) if render else None
     frames = []
     rows = []
     for prim in DEMO_PRIMITIVES:
-        sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
-        before = _safe_render(sim) if render else None
+        sim.reset(resting_state=min(prim.state, len(states) - 1), xy=(0.5, 0.0), yaw=0.0)
+        before = renderer.take() if renderer else None
         contact, normal, motion = scripted_action(sim, prim)
         out = sim.execute(contact, motion, normal=normal)
         row = dict(primitive=prim.name, **_describe(out))
         rows.append(row)
-        after = _safe_render(sim) if render else None
+        after = renderer.take() if renderer else None
         frames.append((prim.name, before, after))
         echo(
             f"{prim.name:5s} contact ({contact[0]:.3f}, {contact[1]:.3f}, {contact[2]:.3f}) m, "
@@ -112,13 +114,23 @@ def _tick(ok: bool) -> str:
     return "success" if ok else "fail   "
 
 
-def _safe_render(sim: Simulator):
-    try:
-        return sim.render(480, 360)
-    except Exception as exc:  # no OpenGL here: the demo still runs, without pictures
-        warnings.warn(f"rendering unavailable ({exc}); set MUJOCO_GL=egl on a headless machine",
-                      stacklevel=2)
-        return None
+class _Pictures:
+    """Renders frames until the first failure, then stops trying (a failed GL context can abort)."""
+
+    def __init__(self, sim: Simulator):
+        self._sim = sim
+        self._ok = True
+
+    def take(self):
+        if not self._ok:
+            return None
+        try:
+            return self._sim.render(480, 360)
+        except Exception as exc:  # no OpenGL here: the demo still runs, without pictures
+            self._ok = False
+            warnings.warn(f"rendering unavailable ({exc}); on a headless machine set MUJOCO_GL=egl",
+                          stacklevel=2)
+            return None
 
 
 def _save_grid(frames, path: Path) -> None:

@@ -22,7 +22,7 @@ FINGER_BODY = "finger"
 FINGER_TARGET = "finger_target"
 FINGER_RADIUS = 0.008  # metres
 FINGER_LENGTH = 0.08  # metres, cylinder part of the capsule above the tip
-PARK_POSITION = (-0.3, 0.0, 0.3)  # where the finger waits between primitives, metres
+PARK_POSITION = (0.5, 0.0, -0.3)  # where the finger waits: under the table (it does not collide with it), out of view
 
 OBJECT_CONTACT = 'condim="6" friction="0.5 0.005 0.002" solref="0.005 1" solimp="0.95 0.99 0.001"'
 
