@@ -12,6 +12,8 @@ examples:
   affordplan demo --object cube --out /tmp/demo
   affordplan bench sim                     # primitives per second and overhead over raw physics
   affordplan bench sim --object mug -n 1000 --json
+  affordplan bench sim --pusher arm        # the 7-DOF arm through mink IK
+  affordplan bench sim2sim -n 100          # the same primitives by finger and arm: outcome gap
 """
 
 
@@ -32,6 +34,14 @@ def _cmd_bench_sim(args: argparse.Namespace) -> int:
     else:
         for r in results:
             print(r.report())
+    return 0
+
+
+def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
+    from affordplan.bench import bench_sim2sim
+
+    for name in args.object:
+        print(bench_sim2sim(name, args.n, seed=args.seed, progress=True).report())
     return 0
 
 
@@ -68,10 +78,22 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sim.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     sim.add_argument("-n", type=int, default=500, help="primitives per object (default: %(default)s)")
-    sim.add_argument("--pusher", default="finger", choices=["finger"], help="pusher (default: finger)")
+    sim.add_argument("--pusher", default="finger", choices=["finger", "arm"], help="pusher (default: finger)")
     sim.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     sim.add_argument("--json", action="store_true", help="print JSON instead of a report")
     sim.set_defaults(func=_cmd_bench_sim)
+
+    s2s = bench_sub.add_parser(
+        "sim2sim", help="finger vs arm on the same random primitives",
+        description="Run the same random primitives with the finger and with the arm and print how far "
+                    "the object's final poses differ (mean and 90th percentile).",
+        epilog="example:\n  affordplan bench sim2sim --object cube mug -n 100",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    s2s.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
+    s2s.add_argument("-n", type=int, default=100, help="primitives per object (default: %(default)s)")
+    s2s.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    s2s.set_defaults(func=_cmd_bench_sim2sim)
     return parser
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from affordplan import cli
@@ -45,3 +46,13 @@ def test_cli_help_has_examples(capsys):
     with pytest.raises(SystemExit):
         cli.main(["--help"])
     assert "examples:" in capsys.readouterr().out
+
+
+def test_bench_sim2sim_compares_identical_primitives():
+    from affordplan.bench import bench_sim2sim
+
+    r = bench_sim2sim("cube", n=4, progress=False)
+    assert r.compared + r.skipped == 4
+    assert len(r.displacement_diff_m) == r.compared
+    assert np.all(r.displacement_diff_m >= 0) and np.all(r.rotation_diff_rad >= 0)
+    assert "p90" in r.report()

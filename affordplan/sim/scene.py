@@ -52,7 +52,8 @@ def _object_xml(obj: ObjectModel) -> tuple[str, str]:
     return "\n".join(assets), body
 
 
-def _obstacle_xml(i: int, box: Box) -> str:
+def obstacle_geom_xml(i: int, box: Box) -> str:
+    """MJCF geom of obstacle ``i`` (named ``obstacle{i}``)."""
     half = np.asarray(box.size) / 2
     quat = [math.cos(box.yaw / 2), 0.0, 0.0, math.sin(box.yaw / 2)]
     return (
@@ -85,12 +86,27 @@ def _finger_xml() -> str:
 </body>"""
 
 
+PUSHERS = ("finger", "arm")
+
+
 def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = "finger") -> str:
-    """MJCF text of the scene. ``pusher`` is ``"finger"`` (a mocap-welded fingertip)."""
-    if pusher != "finger":
+    """MJCF text of the scene.
+
+    ``pusher``: ``"finger"`` (a fingertip welded to a mocap body) or ``"arm"`` (the 7-DOF arm of
+    :mod:`affordplan.sim.arm`, base at the world origin).
+    """
+    if pusher not in PUSHERS:
         raise ValueError(f"unknown pusher {pusher!r}")
+    from affordplan.sim.arm import arm_actuator_xml, arm_body_xml
+
     assets, body = _object_xml(obj)
-    obstacles_xml = "\n".join(_obstacle_xml(i, b) for i, b in enumerate(obstacles))
+    if pusher == "finger":
+        pusher_xml = _finger_xml()
+        extra = f'<equality><weld body1="{FINGER_TARGET}" body2="{FINGER_BODY}" solref="0.01 1"/></equality>'
+    else:
+        pusher_xml = arm_body_xml()
+        extra = f"<actuator>{arm_actuator_xml()}</actuator>"
+    obstacles_xml = "\n".join(obstacle_geom_xml(i, b) for i, b in enumerate(obstacles))
     return f"""<mujoco model="affordplan">
 <compiler angle="radian"/>
 <option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10"/>
@@ -108,15 +124,14 @@ def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = 
   <light pos="0.5 -0.6 1.5" dir="0 0.4 -1" diffuse="0.8 0.8 0.8" castshadow="true"/>
   <light pos="0.3 0.6 1.2" dir="0 -0.3 -1" diffuse="0.4 0.4 0.4" castshadow="false"/>
   <camera name="overview" pos="0.82 -0.38 0.36" xyaxes="{_look_at((0.82, -0.38, 0.36), (0.52, 0.0, 0.03))}"/>
+  <camera name="wide" pos="1.05 -0.7 0.55" xyaxes="{_look_at((1.05, -0.7, 0.55), (0.4, 0.0, 0.15))}"/>
   <camera name="top" pos="0.52 0 1.3" xyaxes="{_look_at((0.52, 0.0, 1.3), (0.52, 0.0, 0.0))}"/>
   <geom name="table" type="plane" size="1.5 1.5 0.05" material="table" contype="1" conaffinity="1"
         friction="0.5 0.005 0.002"/>
   {obstacles_xml}
   {body}
-  {_finger_xml() if pusher == "finger" else ""}
+  {pusher_xml}
 </worldbody>
-<equality>
-  <weld body1="{FINGER_TARGET}" body2="{FINGER_BODY}" solref="0.01 1"/>
-</equality>
+{extra}
 </mujoco>
 """

@@ -1,9 +1,11 @@
 """The MuJoCo simulator: reset an object, observe it, execute one primitive.
 
-A primitive follows HACMan's protocol (DESIGN.md): the fingertip is placed 4 cm out along the
-contact's outward normal, servoes to 2 cm, then to the contact (the tip's surface touching it); the
+A primitive follows HACMan's protocol (DESIGN.md): the fingertip is brought 4 cm out along the
+contact's outward normal (the finger teleports there; the arm transits at a safe height above the
+obstacles and the object, then descends), servoes to 2 cm, then to the contact (the tip's surface touching it); the
 motion is 3 control steps that each move the target by ``motion * 3 cm`` over 0.5 s; the finger
-retracts 5 cm upwards and leaves, and the object settles (until still, at most 2 s).
+retracts 5 cm upwards and leaves (the arm rises to the safe height), and the object settles (until
+still, at most 2 s).
 
 Physics runs in chunks of ``CHUNK_STEPS`` steps through ``mj_step(..., nstep)``; the pusher target is
 updated and the guards run once per chunk (every 20 ms), so no Python runs per physics step.
@@ -13,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import mujoco
@@ -22,15 +25,10 @@ from scipy.spatial import cKDTree
 from affordplan.errors import InputError
 from affordplan.geometry import check_pose, make_pose, transform_points
 from affordplan.objects.model import ObjectModel
+from affordplan.sim.arm import ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
-from affordplan.sim.scene import (
-    FINGER_BODY,
-    FINGER_RADIUS,
-    FINGER_TARGET,
-    OBJECT_BODY,
-    PARK_POSITION,
-    build_mjcf,
-)
+from affordplan.sim.pushers import ArmPusher, FingerPusher
+from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf
 from affordplan.world import Box, Workspace
 
 CHUNK_STEPS = 10  # physics steps between target updates and guard checks (20 ms)
@@ -57,6 +55,7 @@ class Protocol:
     approach_tilt_tolerance: float = math.radians(5.0)
     approach_disturbance: float = 0.005  # object displacement before contact that fails approach
     approach_disturbance_angle: float = math.radians(3.0)
+    transit_clearance: float = 0.12  # arm transit height above the tallest obstacle or the object
 
 
 @dataclass
@@ -68,10 +67,13 @@ class Outcome:
         n_steps: physics steps simulated.
         approach_ok: the fingertip reached the contact without disturbing the object first.
         valid: no physics guard fired (see :mod:`affordplan.sim.guards`).
-        tracking_error_max: largest tip-to-target distance during the motion, metres.
+        tracking_error_max, tracking_error_median: fingertip-to-target distance during the motion,
+            sampled every 20 ms, metres.
         invalid_reason: name of the guard that fired, if any.
         contact, normal, motion: the action as executed (world frame; motion clipped to [-1, 1]).
         success: set by skills that judge the outcome; ``None`` here.
+        arm_collisions: (arm geom, obstacle or table geom) name pairs that touched during the
+            primitive (arm pusher; the fingertip touching the table is not counted).
     """
 
     pose_before: np.ndarray
@@ -80,11 +82,13 @@ class Outcome:
     approach_ok: bool
     valid: bool
     tracking_error_max: float
+    tracking_error_median: float = 0.0
     invalid_reason: str | None = None
     contact: np.ndarray = field(default_factory=lambda: np.zeros(3))
     normal: np.ndarray = field(default_factory=lambda: np.zeros(3))
     motion: np.ndarray = field(default_factory=lambda: np.zeros(3))
     success: bool | None = None
+    arm_collisions: tuple[tuple[str, str], ...] = ()
 
 
 class _Abort(Exception):
@@ -97,7 +101,8 @@ class Simulator:
     Args:
         obj: the object to simulate.
         obstacles: boxes standing on the table.
-        pusher: ``"finger"`` (a fingertip welded to a mocap body; fast, for training).
+        pusher: ``"finger"`` (a fingertip welded to a mocap body; fast, for training) or ``"arm"``
+            (a 7-DOF arm driven by mink IK; see :mod:`affordplan.sim.arm`).
         seed: seeds the point-cloud sampling; physics itself is deterministic.
         workspace: where objects live; the guards allow a margin around it.
     """
@@ -107,8 +112,8 @@ class Simulator:
         workspace: Workspace = Workspace(), protocol: Protocol = Protocol(),
         guard_limits: GuardLimits = GuardLimits(),
     ):
-        if pusher != "finger":
-            raise InputError(f"unknown pusher {pusher!r}; this version supports 'finger'")
+        if pusher not in PUSHERS:
+            raise InputError(f"unknown pusher {pusher!r}; expected one of {PUSHERS}")
         self.obj = obj
         self.obstacles: tuple[Box, ...] = tuple(obstacles)
         self.pusher = pusher
@@ -121,11 +126,18 @@ class Simulator:
         self._object_body = m.body(OBJECT_BODY).id
         self._object_qpos = int(m.jnt_qposadr[m.body_jntadr[self._object_body]])
         self._object_qvel = int(m.jnt_dofadr[m.body_jntadr[self._object_body]])
-        self._finger_body = m.body(FINGER_BODY).id
-        self._finger_qpos = int(m.jnt_qposadr[m.body_jntadr[self._finger_body]])
-        self._finger_qvel = int(m.jnt_dofadr[m.body_jntadr[self._finger_body]])
-        self._mocap = int(m.body_mocapid[m.body(FINGER_TARGET).id])
-        self._finger_geom = m.geom("finger_tip").id
+        if pusher == "finger":
+            self._pusher = FingerPusher(m, self.data)
+            self._ik = None
+        else:
+            self._ik = ArmIK(self.obstacles)
+            self._pusher = ArmPusher(m, self.data, self._ik, CHUNK_STEPS * m.opt.timestep, self._safe_height)
+        self._obstacle_geoms = np.array([m.geom(f"obstacle{i}").id for i in range(len(self.obstacles))], dtype=int)
+        self._table_geom = m.geom("table").id
+        self._collisions: set[tuple[int, int]] = set()
+        self._tracking: list[float] = []  # fingertip tracking errors of the current motion, metres
+        # Called with the simulator after every control chunk (20 ms): for videos and probes.
+        self.on_chunk: Callable[[Simulator], None] | None = None
         hull = obj.hull.vertices
         step = max(1, len(hull) // 256)
         self._guard = PhysicsGuard(m, self.data, self._object_body, hull[::step], workspace, guard_limits)
@@ -160,7 +172,7 @@ class Simulator:
         mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
         self.data.qpos[self._object_qpos:self._object_qpos + 3] = T[:3, 3]
         self.data.qpos[self._object_qpos + 3:self._object_qpos + 7] = quat
-        self._place_finger(np.asarray(PARK_POSITION))
+        self._pusher.home()
         if settle:
             try:
                 self._guard.arm()
@@ -218,35 +230,43 @@ class Simulator:
         p = self.protocol
         steps0 = self.physics_steps
         pose_before = self.object_pose()
-        result = dict(approach_ok=False, valid=True, invalid_reason=None, tracking_error_max=0.0)
+        radius = self._pusher.radius
+        touch = self._clamp(contact + radius * normal)
+        pre = self._clamp(touch + p.standoff * normal)
+        if self._ik is not None:
+            self._ik.check_reachable([pre, touch], self._pusher.q)
+        result = dict(approach_ok=False, valid=True, invalid_reason=None)
         self._guard.arm()
+        self._collisions.clear()
+        self._tracking.clear()
         try:
-            touch = self._clamp(contact + FINGER_RADIUS * normal)
-            result["approach_ok"] = self._approach(touch, normal, pose_before)
+            result["approach_ok"] = self._approach(pre, touch, normal, pose_before)
             if result["approach_ok"]:
                 target = touch
                 for _ in range(p.motion_steps):
                     nxt = self._clamp(target + p.motion_step * motion)
-                    err = self._servo(target, nxt, p.motion_step_time, track=True)
-                    result["tracking_error_max"] = max(result["tracking_error_max"], err)
+                    self._servo(target, nxt, p.motion_step_time, track=True)
                     target = nxt
             self._retract()
             self._settle(p.settle_time_max)
         except _Abort as abort:
             result.update(valid=False, invalid_reason=str(abort))
-            self._place_finger(np.asarray(PARK_POSITION))
+            self._pusher.home()
+        names = tuple(sorted({(self.model.geom(a).name, self.model.geom(b).name) for a, b in self._collisions}))
         return Outcome(
             pose_before=pose_before, pose_after=self.object_pose(),
             n_steps=self.physics_steps - steps0, contact=contact, normal=normal, motion=motion,
+            arm_collisions=names,
+            tracking_error_max=max(self._tracking, default=0.0),
+            tracking_error_median=float(np.median(self._tracking)) if self._tracking else 0.0,
             **result,
         )
 
-    def _approach(self, touch: np.ndarray, normal: np.ndarray, pose_before: np.ndarray) -> bool:
+    def _approach(self, pre: np.ndarray, touch: np.ndarray, normal: np.ndarray, pose_before: np.ndarray) -> bool:
         p = self.protocol
-        pre = self._clamp(touch + p.standoff * normal)
         mid = self._clamp(touch + p.mid_standoff * normal)
-        self._place_finger(pre)
-        if self._finger_penetrates():
+        self._pusher.go_to(pre, self._servo)
+        if self._pusher_penetrates():
             return False
         self._servo(pre, mid, p.approach_time)
         self._servo(mid, touch, p.approach_time)
@@ -254,32 +274,27 @@ class Simulator:
         moved = np.linalg.norm(pose[:3, 3] - pose_before[:3, 3])
         R = pose[:3, :3] @ pose_before[:3, :3].T
         turned = math.acos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))
-        tip = self.data.xpos[self._finger_body]
-        axis = self.data.xmat[self._finger_body].reshape(3, 3)[:, 2]
-        tilt = math.acos(np.clip(axis[2], -1.0, 1.0))
         return bool(
-            np.linalg.norm(tip - touch) <= p.approach_position_tolerance
-            and tilt <= p.approach_tilt_tolerance
+            np.linalg.norm(self._pusher.tip() - touch) <= p.approach_position_tolerance
+            and self._pusher.tilt() <= p.approach_tilt_tolerance
             and moved <= p.approach_disturbance
             and turned <= p.approach_disturbance_angle
         )
 
     def _retract(self) -> None:
-        start = self.data.mocap_pos[self._mocap].copy()
+        start = self._pusher.target()
         self._servo(start, start + np.array([0.0, 0.0, self.protocol.retract_height]), self.protocol.retract_time)
-        self._place_finger(np.asarray(PARK_POSITION))
+        self._pusher.leave(self._servo)
 
-    def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False) -> float:
-        """Move the finger target linearly from ``start`` to ``end``; return the max tracking error."""
+    def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False) -> None:
+        """Move the fingertip target linearly from ``start`` to ``end``; ``track`` logs the error."""
         n_chunks = max(1, round(duration / (CHUNK_STEPS * self.model.opt.timestep)))
-        worst = 0.0
         for k in range(1, n_chunks + 1):
             target = start + (end - start) * (k / n_chunks)
-            self.data.mocap_pos[self._mocap] = target
+            self._pusher.command(target)
             self._step(CHUNK_STEPS)
             if track:
-                worst = max(worst, float(np.linalg.norm(self.data.xpos[self._finger_body] - target)))
-        return worst
+                self._tracking.append(float(np.linalg.norm(self._pusher.tip() - target)))
 
     def _settle(self, max_time: float) -> None:
         p = self.protocol
@@ -299,32 +314,55 @@ class Simulator:
         mujoco.mj_step(self.model, self.data, nstep=n)
         self.physics_time += time.perf_counter() - t0
         self.physics_steps += n
+        if self._ik is not None:
+            self._record_arm_collisions()
+        if self.on_chunk is not None:
+            self.on_chunk(self)
         reason = self._guard.check()
         if reason is not None:
             raise _Abort(reason)
 
-    # --------------------------------------------------------------- finger
+    def _record_arm_collisions(self) -> None:
+        d = self.data
+        if d.ncon == 0:
+            return
+        pairs = d.contact.geom
+        arm_geoms = self._pusher.geoms
+        for a_col, b_col in ((0, 1), (1, 0)):
+            is_arm = np.isin(pairs[:, a_col], arm_geoms)
+            other = pairs[:, b_col]
+            hit = is_arm & (np.isin(other, self._obstacle_geoms) | (other == self._table_geom))
+            for a, b in pairs[hit][:, [a_col, b_col]]:
+                if not (b == self._table_geom and self.model.geom(int(a)).name == "fingertip_c"):
+                    self._collisions.add((int(a), int(b)))
+
+    def _safe_height(self) -> float:
+        """Fingertip height for arm transit: clear of the obstacles and the object."""
+        tallest = max([b.size[2] for b in self.obstacles] + [0.0])
+        top = float(np.max(transform_points(self.object_pose(), self.obj.hull.vertices)[:, 2]))
+        return max(tallest, top) + self.protocol.transit_clearance
+
+    @property
+    def last_tracking_errors(self) -> list[float]:
+        """Fingertip-to-target distances (metres, every 20 ms) during the last primitive's motion."""
+        return list(self._tracking)
+
+    # -------------------------------------------------------------- pusher
     def _clamp(self, p: np.ndarray) -> np.ndarray:
         """Keep the fingertip above the table."""
         q = np.array(p, dtype=float)
-        q[2] = max(q[2], FINGER_RADIUS + 0.001)
+        q[2] = max(q[2], self._pusher.radius + 0.001)
         return q
 
-    def _place_finger(self, pos: np.ndarray) -> None:
-        """Teleport the finger and its target to ``pos`` at rest."""
+    def _pusher_penetrates(self, depth: float = 0.001) -> bool:
+        """Whether the pusher is inside the object or an obstacle by more than ``depth`` metres."""
         d = self.data
-        d.mocap_pos[self._mocap] = pos
-        d.qpos[self._finger_qpos:self._finger_qpos + 3] = pos
-        d.qpos[self._finger_qpos + 3:self._finger_qpos + 7] = (1.0, 0.0, 0.0, 0.0)
-        d.qvel[self._finger_qvel:self._finger_qvel + 6] = 0.0
-        mujoco.mj_forward(self.model, d)
-
-    def _finger_penetrates(self, depth: float = 0.001) -> bool:
-        c = self.data.contact
-        if self.data.ncon == 0:
+        if d.ncon == 0:
             return False
-        involved = (c.geom[:, 0] == self._finger_geom) | (c.geom[:, 1] == self._finger_geom)
-        return bool(np.any(involved & (c.dist < -depth)))
+        c = d.contact
+        involved = np.isin(c.geom[:, 0], self._pusher.geoms) | np.isin(c.geom[:, 1], self._pusher.geoms)
+        not_table = (c.geom[:, 0] != self._table_geom) & (c.geom[:, 1] != self._table_geom)
+        return bool(np.any(involved & not_table & (c.dist < -depth)))
 
     # -------------------------------------------------------------- render
     def render(self, width: int = 640, height: int = 480, camera: str = "overview") -> np.ndarray:

@@ -1,0 +1,141 @@
+"""What pushes: a free fingertip (fast, for training) or the 7-DOF arm (what a user runs).
+
+Both expose the same small interface to :class:`~affordplan.sim.simulator.Simulator`, which owns
+the primitive protocol and the physics loop:
+
+- ``home()``: put the pusher out of the way, at rest (no physics);
+- ``go_to(pos, servo)``: bring the fingertip to ``pos`` before an approach (the finger teleports;
+  the arm transits at a safe height, using ``servo`` to run physics);
+- ``command(target)``: set the fingertip target for the next control chunk;
+- ``leave(servo)``: get clear of the object after a primitive;
+- ``tip()``, ``tilt()``: fingertip position (world, metres) and its angle from pointing down (rad).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import mujoco
+import numpy as np
+
+from affordplan.sim import arm
+from affordplan.sim.scene import FINGER_BODY, FINGER_RADIUS, FINGER_TARGET, PARK_POSITION
+
+Servo = Callable[[np.ndarray, np.ndarray, float], None]
+
+
+class FingerPusher:
+    """A capsule fingertip welded to a mocap body; its tip sphere centre is the body origin."""
+
+    name = "finger"
+    radius = FINGER_RADIUS
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
+        self.model, self.data = model, data
+        body = model.body(FINGER_BODY).id
+        self._body = body
+        self._qpos = int(model.jnt_qposadr[model.body_jntadr[body]])
+        self._qvel = int(model.jnt_dofadr[model.body_jntadr[body]])
+        self._mocap = int(model.body_mocapid[model.body(FINGER_TARGET).id])
+        self.geoms = np.array([model.geom("finger_tip").id])
+
+    def home(self) -> None:
+        self._teleport(np.asarray(PARK_POSITION, dtype=float))
+
+    def go_to(self, pos: np.ndarray, servo: Servo) -> None:
+        self._teleport(pos)
+
+    def command(self, target: np.ndarray) -> None:
+        self.data.mocap_pos[self._mocap] = target
+
+    def target(self) -> np.ndarray:
+        return self.data.mocap_pos[self._mocap].copy()
+
+    def leave(self, servo: Servo) -> None:
+        self.home()
+
+    def tip(self) -> np.ndarray:
+        return self.data.xpos[self._body].copy()
+
+    def tilt(self) -> float:
+        axis = self.data.xmat[self._body].reshape(3, 3)[:, 2]  # the capsule points up from the tip
+        return math.acos(float(np.clip(axis[2], -1.0, 1.0)))
+
+    def _teleport(self, pos: np.ndarray) -> None:
+        d = self.data
+        d.mocap_pos[self._mocap] = pos
+        d.qpos[self._qpos:self._qpos + 3] = pos
+        d.qpos[self._qpos + 3:self._qpos + 7] = (1.0, 0.0, 0.0, 0.0)
+        d.qvel[self._qvel:self._qvel + 6] = 0.0
+        mujoco.mj_forward(self.model, d)
+
+
+class ArmPusher:
+    """The 7-DOF arm of :mod:`affordplan.sim.arm`, its fingertip driven by mink IK at 50 Hz."""
+
+    name = "arm"
+    radius = arm.TIP_RADIUS
+    transit_speed = 0.5  # m/s, fingertip speed between primitives
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, ik: arm.ArmIK, chunk_time: float,
+                 safe_height: Callable[[], float]):
+        self.model, self.data, self.ik = model, data, ik
+        self._chunk_time = chunk_time
+        self._safe_height = safe_height
+        joints = [model.joint(n) for n in arm.JOINTS]
+        self._qpos = np.array([int(j.qposadr[0]) for j in joints])
+        self._qvel = np.array([int(j.dofadr[0]) for j in joints])
+        acts = [model.actuator(f"act{i + 1}").id for i in range(7)]
+        self._act = np.array([int(model.actuator_actadr[a]) for a in acts])
+        self._ctrl = np.array(acts)
+        self._site = model.site(arm.FINGERTIP_SITE).id
+        self._target = np.zeros(3)
+        bodies = {model.body(n).id for n in arm.ARM_BODIES}
+        self.geoms = np.array([g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in bodies])
+
+    @property
+    def q(self) -> np.ndarray:
+        return self.data.qpos[self._qpos].copy()
+
+    def home(self) -> None:
+        d = self.data
+        d.qpos[self._qpos] = arm.HOME
+        d.qvel[self._qvel] = 0.0
+        d.act[self._act] = arm.HOME
+        d.ctrl[self._ctrl] = 0.0
+        self.ik.set_q(np.array(arm.HOME))
+        mujoco.mj_forward(self.model, d)
+        self._target = self.tip()
+
+    def go_to(self, pos: np.ndarray, servo: Servo) -> None:
+        """Transit: up to the safe height, across, and down to ``pos``."""
+        start = self._target.copy()
+        z_safe = max(self._safe_height(), start[2], pos[2])
+        waypoints = [start, np.array([start[0], start[1], z_safe]), np.array([pos[0], pos[1], z_safe]), pos]
+        for a, b in zip(waypoints[:-1], waypoints[1:]):
+            dist = float(np.linalg.norm(b - a))
+            if dist > 1e-4:
+                servo(a, b, max(dist / self.transit_speed, self._chunk_time))
+
+    def command(self, target: np.ndarray) -> None:
+        self._target = np.asarray(target, dtype=float).copy()
+        q_next = self.ik.step(self._target)
+        self.data.ctrl[self._ctrl] = (q_next - self.data.act[self._act]) / self._chunk_time
+
+    def target(self) -> np.ndarray:
+        return self._target.copy()
+
+    def leave(self, servo: Servo) -> None:
+        start = self._target.copy()
+        up = np.array([start[0], start[1], max(self._safe_height(), start[2])])
+        if up[2] - start[2] > 1e-4:
+            servo(start, up, max((up[2] - start[2]) / self.transit_speed, self._chunk_time))
+        self.data.ctrl[self._ctrl] = 0.0  # hold the last target
+
+    def tip(self) -> np.ndarray:
+        return self.data.site_xpos[self._site].copy()
+
+    def tilt(self) -> float:
+        axis = self.data.site_xmat[self._site].reshape(3, 3)[:, 2]  # points down when vertical
+        return math.acos(float(np.clip(-axis[2], -1.0, 1.0)))

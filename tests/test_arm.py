@@ -1,0 +1,85 @@
+"""The 7-DOF arm: pushes like the finger, tracks its target, clears walls in transit, refuses the unreachable."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+import affordplan as ap
+from affordplan.errors import ReachabilityError
+from affordplan.sim.arm import HOME, ArmIK
+from primitives import rewards
+
+
+def face_push(sim: ap.Simulator, xy=(0.5, 0.0), stroke: float = 2.0 / 3.0) -> ap.Outcome:
+    T0 = sim.reset(resting_state=0, xy=xy, yaw=0.0)
+    return sim.execute(T0[:3, 3] - np.array([0.05, 0.0, 0.0]), (stroke, 0.0, 0.0), normal=(-1.0, 0.0, 0.0))
+
+
+def test_arm_push_moves_the_cube_like_the_finger(cube):
+    by_arm = face_push(ap.Simulator(cube, pusher="arm"))
+    by_finger = face_push(ap.Simulator(cube, pusher="finger"))
+    assert by_arm.approach_ok and by_arm.valid
+    gap = np.linalg.norm(by_arm.pose_after[:3, 3] - by_finger.pose_after[:3, 3])
+    assert gap < 0.02
+    m = rewards.motion(by_arm.pose_before, by_arm.pose_after)
+    assert 0.04 <= m.p[0] <= 0.09 and m.theta_deg < 5.0
+    assert by_arm.tracking_error_max <= 0.005
+    assert by_arm.tracking_error_median <= by_arm.tracking_error_max
+
+
+def test_no_arm_link_touches_a_wall_between_home_and_object(cube):
+    """The wall stands between the arm's home pose and the cube; the arm transits over it."""
+    wall = ap.Box(center=(0.45, 0.0), size=(0.03, 0.5, 0.16))
+    sim = ap.Simulator(cube, obstacles=[wall], pusher="arm")
+    T0 = sim.reset(resting_state=0, xy=(0.62, 0.0), yaw=0.0)
+    home_tip = sim.data.site_xpos[sim.model.site("fingertip").id].copy()
+    assert home_tip[0] < 0.45 < T0[0, 3]  # home is on the near side of the wall
+
+    m, d = sim.model, sim.data
+    wall_geom = m.geom("obstacle0").id
+    arm_bodies = {m.body(n).id for n in ("link1", "link2", "link3", "link4", "link5", "link6", "link7", "hand")}
+    touches = []
+
+    def read_contacts(s: ap.Simulator) -> None:
+        for c in d.contact[: d.ncon]:
+            g1, g2 = int(c.geom1), int(c.geom2)
+            if wall_geom in (g1, g2):
+                other = g2 if g1 == wall_geom else g1
+                if int(m.geom_bodyid[other]) in arm_bodies:
+                    touches.append(m.geom(other).name)
+
+    sim.on_chunk = read_contacts
+    # Contact on the far (+x) face, pushing back towards the wall: the arm must pass over it.
+    out = sim.execute(T0[:3, 3] + np.array([0.05, 0.0, 0.0]), (-0.3, 0.0, 0.0), normal=(1.0, 0.0, 0.0))
+    assert out.approach_ok
+    assert touches == []
+    assert all("obstacle0" not in pair for pair in out.arm_collisions)
+
+
+def test_unreachable_contact_raises_at_once(cube):
+    sim = ap.Simulator(cube, pusher="arm")
+    T0 = sim.reset()
+    steps = sim.physics_steps
+    t0 = time.perf_counter()
+    with pytest.raises(ReachabilityError, match="cannot reach"):
+        sim.execute((1.3, 0.6, 0.05), (1.0, 0.0, 0.0), normal=(-1.0, 0.0, 0.0))
+    assert time.perf_counter() - t0 < 5.0  # no hang (a generous bound; it takes milliseconds)
+    assert sim.physics_steps == steps  # nothing simulated
+    assert np.array_equal(sim.object_pose(), T0)
+
+
+@pytest.mark.parametrize("x, y", [(0.3, -0.3), (0.3, 0.3), (0.75, -0.3), (0.75, 0.3), (0.75, 0.0), (0.5, 0.0)])
+def test_the_arm_reaches_the_whole_workspace_low_and_pointing_down(x, y):
+    ik = ArmIK()
+    ik.check_reachable([np.array([x, y, 0.01]), np.array([x, y, 0.15])], np.array(HOME))
+
+
+def test_arm_determinism(cube):
+    poses = []
+    for _ in range(2):
+        sim = ap.Simulator(cube, pusher="arm")
+        poses.append(face_push(sim, xy=(0.55, 0.1), stroke=0.8).pose_after)
+    assert np.array_equal(poses[0], poses[1])
