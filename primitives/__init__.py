@@ -1,4 +1,5 @@
-"""Learned primitives: the seed's objectives, and (in later releases) policies and skills."""
+"""Learned primitives: the seed's objectives, the one-step environment, the hybrid actor-critic,
+training (``python -m primitives.train``) and evaluation (``python -m primitives.evaluate``)."""
 
 from primitives import rewards
 

@@ -1,0 +1,59 @@
+"""Learning curves (success and reward vs steps) and the memory curve of training runs, as a PNG.
+
+    python -m primitives.curves runs/push runs/roll runs/spin --out curves.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+from pathlib import Path
+
+
+def read_log(run: str | Path) -> dict[str, list[float]]:
+    with open(Path(run) / "log.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
+
+
+def plot_curves(runs: list[str | Path], out: str | Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    for run in runs:
+        log = read_log(run)
+        if not log:
+            continue
+        label = Path(run).name
+        axes[0].plot(log["step"], log["success_recent"], label=label)
+        axes[1].plot(log["step"], log["reward_recent"], label=label)
+        axes[2].plot(log["minutes"], log["rss_mb_total"], label=label)
+    axes[0].set(xlabel="primitives executed", ylabel="success (last 500, exploring)", ylim=(0, 1),
+                title="training success")
+    axes[1].set(xlabel="primitives executed", ylabel="reward = -L (last 500)", title="training reward")
+    axes[2].set(xlabel="minutes", ylabel="resident memory, learner + workers (MB)", title="memory")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m primitives.curves", description=__doc__.split("\n\n")[0],
+                                epilog="example:\n  python -m primitives.curves runs/push runs/roll --out curves.png",
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("runs", nargs="+", help="run folders (each with a log.csv)")
+    p.add_argument("--out", default="curves.png")
+    args = p.parse_args(argv)
+    plot_curves(args.runs, args.out)
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,217 @@
+"""Evaluate a trained primitive with the seed's protocol.
+
+    python -m primitives.evaluate push --weights runs/push/policy.pt --trials 200 --objects random
+    python -m primitives.evaluate push --objects seed7 --plot fig5_push.png --json
+    python -m primitives.evaluate push --critic-map critic_map.png
+
+Protocol (the seed's Section IV): each trial starts the object in a stable pose (a resting state
+drawn by its probability, a random position in the middle of the workspace and a random yaw), the
+policy acts greedily (argmax of the critic map, the actor's motion without noise), and success is the
+seed's criterion for that primitive. ``--objects random`` uses the held-out procedural split (never
+trained on); ``seed7`` the seed's seven objects (``--trials`` each); paths evaluate mesh files.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
+from primitives.networks import HybridActorCritic
+
+# The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
+SEED_FIG5 = {
+    "cube": (0.955, 0.85, 0.61), "mug": (0.625, 0.825, 0.29), "lunch_box": (0.825, 0.52, 0.485),
+    "tape": (0.465, 0.75, 0.56), "pill_bottle": (0.135, 0.845, 0.60), "planter_1": (0.28, 0.74, 0.485),
+    "planter_2": (0.245, 0.79, 0.405),
+}
+SEED_FIG3 = {"push": 0.43, "roll": 0.75, "spin": 0.47}
+WEIGHTS_DIR = Path(__file__).parent / "weights"
+
+
+def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActorCritic:
+    """A policy from a ``policy.pt`` / ``checkpoint.pt`` file, or the shipped weights."""
+    from primitives import checkpoint as ckpt
+
+    path = Path(weights) if weights else WEIGHTS_DIR / f"{primitive}.pt"
+    if not path.exists():
+        raise ckpt.CheckpointError(f"no weights at {path}")
+    try:
+        state = torch.load(path, map_location="cpu", weights_only=False)
+    except Exception as exc:
+        raise ckpt.CheckpointError(f"weights {path} are damaged ({type(exc).__name__}: {exc})") from exc
+    if isinstance(state, dict) and "model" in state:
+        state = state["model"]
+    model = HybridActorCritic()
+    model.load_state_dict(state)
+    model.eval()
+    return model
+
+
+def greedy_action(model: HybridActorCritic, obs: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+    """Deterministic action: ``(contact index, motion, critic map)``."""
+    actions, q = model.maps(torch.from_numpy(obs)[None])
+    idx = int(q[0].argmax())
+    return idx, actions[0, idx].numpy().astype(np.float64), q[0].numpy()
+
+
+@dataclass
+class EvalResult:
+    primitive: str
+    objects: str
+    per_object: dict[str, list[bool]] = field(default_factory=dict)
+    invalid: int = 0
+
+    @property
+    def success_rate(self) -> float:
+        allv = [s for v in self.per_object.values() for s in v]
+        return float(np.mean(allv)) if allv else 0.0
+
+    def rates(self) -> dict[str, float]:
+        return {k: float(np.mean(v)) for k, v in self.per_object.items()}
+
+    def as_dict(self) -> dict:
+        return dict(primitive=self.primitive, objects=self.objects, success=self.success_rate,
+                    trials=sum(len(v) for v in self.per_object.values()), invalid=self.invalid,
+                    per_object=self.rates())
+
+
+def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str, ...] = "random",
+             trials: int = 200, seed: int = 1234, progress: bool = True) -> EvalResult:
+    """Success over ``trials`` stable starts (per object for ``seed7`` and paths)."""
+    if objects == "random":
+        cfg, plan = EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1), [None] * trials
+    else:
+        names = SEED_SEVEN if objects == "seed7" else tuple(objects)
+        cfg = EnvConfig(primitive, objects=names, episodes_per_object=1)
+        plan = [n for n in names for _ in range(trials)]
+    env = PrimitiveEnv(cfg, seed=seed)
+    result = EvalResult(primitive, objects if isinstance(objects, str) else "paths")
+    for key in tqdm(plan, desc=f"evaluate {primitive}", disable=not progress, unit="trial", mininterval=2.0):
+        obs = env.reset(object_key=key)
+        idx, motion, _ = greedy_action(model, obs)
+        res = env.step(idx, motion)
+        result.invalid += not res.valid
+        name = "random" if key is None else str(key)
+        result.per_object.setdefault(name, []).append(res.success)
+    env.close()
+    return result
+
+
+def plot_results(results: list[EvalResult], path: str | os.PathLike) -> None:
+    """Bar charts like the seed's Fig. 3 (mean success per primitive) and Fig. 5 (per object)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    per_obj = [r for r in results if r.objects != "random"]
+    fig, axes = plt.subplots(1, 2 if per_obj else 1, figsize=(13 if per_obj else 5, 4), squeeze=False)
+    ax = axes[0, 0]
+    names = [r.primitive for r in results]
+    ours = [r.success_rate for r in results]
+    seed = [SEED_FIG3.get(n, np.nan) for n in names]
+    x = np.arange(len(names))
+    ax.bar(x - 0.2, seed, 0.4, label="seed (HACMan-AFF)", color="#bbbbbb")
+    ax.bar(x + 0.2, ours, 0.4, label="affordplan", color="#d98c2b")
+    ax.set_xticks(x, names)
+    ax.set_ylim(0, 1)
+    ax.set_ylabel("success rate")
+    ax.set_title(f"mean success ({results[0].objects} objects)")
+    ax.legend()
+    if per_obj:
+        ax = axes[0, 1]
+        objs = list(per_obj[0].rates())
+        width = 0.8 / (2 * len(per_obj))
+        for k, r in enumerate(per_obj):
+            col = PRIMITIVES.index(r.primitive)
+            xs = np.arange(len(objs))
+            ax.bar(xs + (2 * k) * width - 0.4, [SEED_FIG5.get(o, (np.nan,) * 3)[col] for o in objs], width,
+                   color="#bbbbbb", label="seed" if k == 0 else None)
+            ax.bar(xs + (2 * k + 1) * width - 0.4, [r.rates()[o] for o in objs], width,
+                   label=f"affordplan {r.primitive}")
+        ax.set_xticks(np.arange(len(objs)), objs, rotation=20)
+        ax.set_ylim(0, 1)
+        ax.set_title("success per object (grey: seed's Fig. 5)")
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_critic_map(model: HybridActorCritic, primitive: str, path: str | os.PathLike, object_name: str = "cube",
+                    seed: int = 0) -> None:
+    """The seed's Fig. 2: the cloud coloured by critic value, the chosen contact and its motion."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    env = PrimitiveEnv(EnvConfig(primitive, objects=(object_name,), episodes_per_object=1), seed=seed)
+    obs = env.reset(object_key=object_name)
+    idx, motion, q = greedy_action(model, obs)
+    pts = env.points
+    fig = plt.figure(figsize=(6, 5))
+    ax = fig.add_subplot(projection="3d")
+    sc = ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], c=q, cmap="viridis", s=6)
+    ax.scatter(*pts[idx], color="red", s=60, label="chosen contact")
+    ax.quiver(*pts[idx], *(0.09 * motion), color="red", linewidth=2, label="motion (x 9 cm)")
+    fig.colorbar(sc, ax=ax, shrink=0.7, label="critic value Q")
+    ax.set_title(f"{primitive} critic map on the {object_name}")
+    ax.legend(loc="upper left", fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    env.close()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m primitives.evaluate", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n"
+               "  python -m primitives.evaluate push --trials 200 --objects random\n"
+               "  python -m primitives.evaluate roll --objects seed7 --trials 50 --plot roll.png --json\n"
+               "  python -m primitives.evaluate spin --weights runs/spin/policy.pt --critic-map map.png",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("primitive", choices=PRIMITIVES)
+    p.add_argument("--weights", default=None, help="policy.pt or checkpoint.pt (default: shipped weights)")
+    p.add_argument("--trials", type=int, default=200)
+    p.add_argument("--objects", nargs="+", default=["random"], help="random | seed7 | mesh paths")
+    p.add_argument("--seed", type=int, default=1234)
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--plot", default=None, help="write bar charts (the seed's Fig. 3 / Fig. 5) here")
+    p.add_argument("--critic-map", default=None, help="write the critic map figure (the seed's Fig. 2) here")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    torch.set_num_threads(1)
+    model = load_policy(args.weights, args.primitive)
+    objects = args.objects[0] if args.objects[0] in ("random", "seed7") else tuple(args.objects)
+    result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json)
+    if args.json:
+        print(json.dumps(result.as_dict(), indent=2))
+    else:
+        print(f"{args.primitive}: success {result.success_rate:.3f} over "
+              f"{sum(len(v) for v in result.per_object.values())} trials ({result.invalid} invalid)")
+        for name, rate in result.rates().items():
+            seed = SEED_FIG5.get(name)
+            ref = f"   seed {seed[PRIMITIVES.index(args.primitive)]:.3f}" if seed else ""
+            print(f"  {name:14s} {rate:.3f}{ref}")
+    if args.plot:
+        plot_results([result], args.plot)
+    if args.critic_map:
+        plot_critic_map(model, args.primitive, args.critic_map)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
