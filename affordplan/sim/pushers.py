@@ -20,24 +20,28 @@ import mujoco
 import numpy as np
 
 from affordplan.sim import arm
-from affordplan.sim.scene import FINGER_BODY, FINGER_RADIUS, FINGER_TARGET, PARK_POSITION
+from affordplan.sim.scene import FINGER_BODY, FINGER_RADIUS, PARK_POSITION
 
 Servo = Callable[[np.ndarray, np.ndarray, float], None]
 
 
 class FingerPusher:
-    """A capsule fingertip welded to a mocap body; its tip sphere centre is the body origin."""
+    """A capsule fingertip on three world-axis slide joints; its tip sphere centre is the body origin.
+
+    Each axis is a position actuator (kp 2000 N/m, kv 40 N s/m) capped at 30 N, like a robot's
+    fingertip; an unbounded push (a mocap weld) squeezes objects out against the table at speeds no
+    robot produces, and a learned policy finds that exploit.
+    """
 
     name = "finger"
     radius = FINGER_RADIUS
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
         self.model, self.data = model, data
-        body = model.body(FINGER_BODY).id
-        self._body = body
-        self._qpos = int(model.jnt_qposadr[model.body_jntadr[body]])
-        self._qvel = int(model.jnt_dofadr[model.body_jntadr[body]])
-        self._mocap = int(model.body_mocapid[model.body(FINGER_TARGET).id])
+        self._body = model.body(FINGER_BODY).id
+        self._qpos = np.array([int(model.joint(f"finger_{a}").qposadr[0]) for a in "xyz"])
+        self._qvel = np.array([int(model.joint(f"finger_{a}").dofadr[0]) for a in "xyz"])
+        self._ctrl = np.array([model.actuator(f"finger_{a}").id for a in "xyz"])
         self.geoms = np.array([model.geom("finger_tip").id])
 
     def home(self) -> None:
@@ -47,10 +51,10 @@ class FingerPusher:
         self._teleport(pos)
 
     def command(self, target: np.ndarray) -> None:
-        self.data.mocap_pos[self._mocap] = target
+        self.data.ctrl[self._ctrl] = target
 
     def target(self) -> np.ndarray:
-        return self.data.mocap_pos[self._mocap].copy()
+        return self.data.ctrl[self._ctrl].copy()
 
     def leave(self, servo: Servo) -> None:
         self.home()
@@ -59,15 +63,13 @@ class FingerPusher:
         return self.data.xpos[self._body].copy()
 
     def tilt(self) -> float:
-        axis = self.data.xmat[self._body].reshape(3, 3)[:, 2]  # the capsule points up from the tip
-        return math.acos(float(np.clip(axis[2], -1.0, 1.0)))
+        return 0.0  # slide joints only: the finger always points down
 
     def _teleport(self, pos: np.ndarray) -> None:
         d = self.data
-        d.mocap_pos[self._mocap] = pos
-        d.qpos[self._qpos:self._qpos + 3] = pos
-        d.qpos[self._qpos + 3:self._qpos + 7] = (1.0, 0.0, 0.0, 0.0)
-        d.qvel[self._qvel:self._qvel + 6] = 0.0
+        d.qpos[self._qpos] = pos
+        d.qvel[self._qvel] = 0.0
+        d.ctrl[self._ctrl] = pos
         mujoco.mj_forward(self.model, d)
 
 

@@ -19,7 +19,6 @@ from affordplan.world import Box
 
 OBJECT_BODY = "object"
 FINGER_BODY = "finger"
-FINGER_TARGET = "finger_target"
 FINGER_RADIUS = 0.008  # metres
 FINGER_LENGTH = 0.08  # metres, cylinder part of the capsule above the tip
 PARK_POSITION = (0.5, 0.0, -0.3)  # where the finger waits: under the table (it does not collide with it), out of view
@@ -75,15 +74,30 @@ def _look_at(pos, target) -> str:
     return _floats(np.concatenate([x, y]))
 
 
+FINGER_KP = 2000.0  # N/m, position gain of each finger axis
+FINGER_KV = 40.0  # N s/m
+FINGER_MAX_FORCE = 10.0  # N per axis: enough to slide, tip and roll these objects (<= 0.5 kg), no more
+
+
 def _finger_xml() -> str:
-    park = _floats(PARK_POSITION)
+    """A fingertip on three slide joints (world x, y, z) with force-limited position actuators."""
+    slide = 'type="slide" armature="0.01" damping="0" limited="false"'
     return f"""
-<body name="{FINGER_TARGET}" mocap="true" pos="{park}"/>
-<body name="{FINGER_BODY}" pos="{park}" gravcomp="1">
-  <freejoint name="finger_joint"/>
+<body name="{FINGER_BODY}" pos="0 0 0" gravcomp="1">
+  <joint name="finger_x" axis="1 0 0" {slide}/>
+  <joint name="finger_y" axis="0 1 0" {slide}/>
+  <joint name="finger_z" axis="0 0 1" {slide}/>
   <geom name="finger_tip" type="capsule" fromto="0 0 0 0 0 {FINGER_LENGTH}" size="{FINGER_RADIUS}"
         mass="0.05" contype="2" conaffinity="0" friction="0.5 0.005 0.002" rgba="0.2 0.2 0.25 1"/>
 </body>"""
+
+
+def _finger_actuators_xml() -> str:
+    return "\n".join(
+        f'<position name="finger_{a}" joint="finger_{a}" kp="{FINGER_KP}" kv="{FINGER_KV}" '
+        f'forcelimited="true" forcerange="{-FINGER_MAX_FORCE} {FINGER_MAX_FORCE}"/>'
+        for a in "xyz"
+    )
 
 
 PUSHERS = ("finger", "arm")
@@ -92,7 +106,7 @@ PUSHERS = ("finger", "arm")
 def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = "finger") -> str:
     """MJCF text of the scene.
 
-    ``pusher``: ``"finger"`` (a fingertip welded to a mocap body) or ``"arm"`` (the 7-DOF arm of
+    ``pusher``: ``"finger"`` (a force-limited fingertip on three slide joints) or ``"arm"`` (the 7-DOF arm of
     :mod:`affordplan.sim.arm`, base at the world origin).
     """
     if pusher not in PUSHERS:
@@ -102,7 +116,7 @@ def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = 
     assets, body = _object_xml(obj)
     if pusher == "finger":
         pusher_xml = _finger_xml()
-        extra = f'<equality><weld body1="{FINGER_TARGET}" body2="{FINGER_BODY}" solref="0.01 1"/></equality>'
+        extra = f"<actuator>{_finger_actuators_xml()}</actuator>"
     else:
         pusher_xml = arm_body_xml()
         extra = f"<actuator>{arm_actuator_xml()}</actuator>"
