@@ -1,6 +1,15 @@
 """Learned primitives: the seed's objectives, the one-step environment, the hybrid actor-critic,
-training (``python -m primitives.train``) and evaluation (``python -m primitives.evaluate``)."""
+training (``python -m primitives.train``), evaluation (``python -m primitives.evaluate``) and the
+trained skills (``load_skill``)."""
 
 from primitives import rewards
 
-__all__ = ["rewards"]
+
+def load_skill(name: str, weights=None):
+    """The ``push``, ``roll`` or ``spin`` skill (see :mod:`primitives.skills`)."""
+    from primitives.skills import load_skill as _load
+
+    return _load(name, weights)
+
+
+__all__ = ["load_skill", "rewards"]

@@ -140,3 +140,29 @@ def test_evaluation_is_deterministic():
     obs = env.reset()
     first, second = greedy_action(model, obs), greedy_action(model, obs)
     assert first[0] == second[0] and np.array_equal(first[1], second[1])
+
+
+def test_skill_acts_and_judges_with_given_weights(tmp_path):
+    import affordplan as ap
+    from affordplan.errors import InputError
+    from primitives import load_skill
+
+    torch.manual_seed(0)
+    torch.save(HybridActorCritic().state_dict(), tmp_path / "w.pt")
+    skill = load_skill("push", weights=tmp_path / "w.pt")
+    sim = ap.Simulator(ap.load_object("cube"))
+    sim.reset()
+    contact, motion = skill.act(sim)
+    assert contact.shape == (3,) and np.all(np.abs(motion) <= 1.0)
+    out = skill.execute(sim)
+    assert out.success == (out.valid and rewards_push_success(out))
+    with pytest.raises(InputError):
+        skill.act(sim, params={"direction": 0.0})
+    with pytest.raises(InputError):
+        load_skill("jump")
+
+
+def rewards_push_success(out) -> bool:
+    from primitives import rewards
+
+    return rewards.push_success(out.pose_before, out.pose_after)
