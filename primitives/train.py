@@ -236,7 +236,7 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
                     except queue.Empty:
                         break
             # 2. Learn, at most replay_ratio samples per collected transition.
-            budget = cfg.replay_ratio * replay.size / cfg.batch_size
+            budget = cfg.replay_ratio * (state["global_step"] - state["invalid"]) / cfg.batch_size
             if replay.size >= cfg.learning_starts:
                 n = 0
                 while state["n_updates"] < budget and n < (4 if env is None else 1 + int(cfg.replay_ratio)):
