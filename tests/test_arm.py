@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -63,11 +61,9 @@ def test_unreachable_contact_raises_at_once(cube):
     sim = ap.Simulator(cube, pusher="arm")
     T0 = sim.reset()
     steps = sim.physics_steps
-    t0 = time.perf_counter()
     with pytest.raises(ReachabilityError, match="cannot reach"):
         sim.execute((1.3, 0.6, 0.05), (1.0, 0.0, 0.0), normal=(-1.0, 0.0, 0.0))
-    assert time.perf_counter() - t0 < 5.0  # no hang (a generous bound; it takes milliseconds)
-    assert sim.physics_steps == steps  # nothing simulated
+    assert sim.physics_steps == steps  # raised before any physics: no silent no-op, no hang
     assert np.array_equal(sim.object_pose(), T0)
 
 

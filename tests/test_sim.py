@@ -150,6 +150,12 @@ def test_bad_reset_raises(cube):
         sim.reset(xy=(2.0, 0.0))
     with pytest.raises(InputError):
         ap.Simulator(cube, pusher="gripper")
+    with pytest.raises(InputError):
+        ap.Simulator(cube, obstacles=[(0.5, 0.0, 0.1)])
+    with pytest.raises(InputError):
+        ap.Simulator("cube")
+    with pytest.raises(InputError, match="unknown camera"):
+        sim.render(camera="nope")
 
 
 def test_motion_is_clipped_to_unit_box(cube):

@@ -114,8 +114,14 @@ class Simulator:
     ):
         if pusher not in PUSHERS:
             raise InputError(f"unknown pusher {pusher!r}; expected one of {PUSHERS}")
+        if not isinstance(obj, ObjectModel):
+            raise InputError(f"obj must be an ObjectModel (see affordplan.load_object), got {type(obj).__name__}")
+        obstacles = tuple(obstacles)
+        for box in obstacles:
+            if not isinstance(box, Box):
+                raise InputError(f"obstacles must be affordplan.Box instances, got {type(box).__name__}")
         self.obj = obj
-        self.obstacles: tuple[Box, ...] = tuple(obstacles)
+        self.obstacles: tuple[Box, ...] = obstacles
         self.pusher = pusher
         self.workspace = workspace
         self.protocol = protocol
@@ -367,6 +373,9 @@ class Simulator:
     # -------------------------------------------------------------- render
     def render(self, width: int = 640, height: int = 480, camera: str = "overview") -> np.ndarray:
         """An RGB image (height, width, 3) of the scene. Headless: set ``MUJOCO_GL=egl``."""
+        if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
+            names = [self.model.camera(i).name for i in range(self.model.ncam)]
+            raise InputError(f"unknown camera {camera!r}; this scene has {names}")
         key = (int(width), int(height))
         if key not in self._renderers:
             self._renderers[key] = mujoco.Renderer(self.model, height=key[1], width=key[0])
