@@ -101,7 +101,7 @@ class Simulator:
     Args:
         obj: the object to simulate.
         obstacles: boxes standing on the table.
-        pusher: ``"finger"`` (a fingertip welded to a mocap body; fast, for training) or ``"arm"``
+        pusher: ``"finger"`` (a force-limited fingertip on slide joints; fast, for training) or ``"arm"``
             (a 7-DOF arm driven by mink IK; see :mod:`affordplan.sim.arm`).
         seed: seeds the point-cloud sampling; physics itself is deterministic.
         workspace: where objects live; the guards allow a margin around it.
