@@ -166,3 +166,17 @@ def rewards_push_success(out) -> bool:
     from primitives import rewards
 
     return rewards.push_success(out.pose_before, out.pose_after)
+
+
+@pytest.mark.parametrize("name", ["push", "roll", "spin"])
+def test_shipped_weights_load_offline_and_act(name):
+    import affordplan as ap
+    from primitives import load_skill
+
+    skill = load_skill(name)  # primitives/weights/NAME.pt, package data
+    sim = ap.Simulator(ap.load_object("cube"), seed=3)
+    sim.reset()
+    contact, motion = skill.act(sim)
+    assert np.all(np.isfinite(contact)) and np.all(np.abs(motion) <= 1.0)
+    again = load_skill(name).act(ap.Simulator(ap.load_object("cube"), seed=3))
+    assert np.array_equal(again[0], contact) and np.array_equal(again[1], motion)  # deterministic
