@@ -80,14 +80,12 @@ def env_config(cfg: TrainConfig) -> EnvConfig:
 
 # ---------------------------------------------------------------------------- acting
 def act(model: HybridActorCritic, obs: np.ndarray, cfg: TrainConfig, rng: np.random.Generator,
-        gen: torch.Generator, explore: bool) -> tuple[int, np.ndarray]:
-    """Contact index and motion for one observation."""
+        gen: torch.Generator) -> tuple[int, np.ndarray]:
+    """Exploring contact index and motion for one observation (greedy acting: evaluate.greedy_action)."""
     actions, q = model.maps(torch.from_numpy(obs)[None])
-    idx = int(choose_contact(q, cfg.temperature, cfg.epsilon, gen, greedy=not explore)[0])
+    idx = int(choose_contact(q, cfg.temperature, cfg.epsilon, gen, greedy=False)[0])
     motion = actions[0, idx].numpy().astype(np.float64)
-    if explore:
-        motion = np.clip(motion + rng.normal(0.0, cfg.motion_noise, size=3), -1.0, 1.0)
-    return idx, motion
+    return idx, np.clip(motion + rng.normal(0.0, cfg.motion_noise, size=3), -1.0, 1.0)
 
 
 def rollout_worker(wid: int, cfg: TrainConfig, seed: int, weights_q: mp.Queue, out_q: mp.Queue, stop) -> None:
@@ -105,7 +103,7 @@ def rollout_worker(wid: int, cfg: TrainConfig, seed: int, weights_q: mp.Queue, o
         except queue.Empty:
             pass
         obs = env.reset()
-        idx, motion = act(model, obs, cfg, rng, gen, explore=True)
+        idx, motion = act(model, obs, cfg, rng, gen)
         res = env.step(idx, motion)
         out_q.put((obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid))
     env.close()
@@ -224,7 +222,7 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
             # 1. Collect.
             if env is not None:
                 obs = env.reset()
-                idx, motion = act(model, obs, cfg, rng, gen, explore=True)
+                idx, motion = act(model, obs, cfg, rng, gen)
                 res = env.step(idx, motion)
                 add(obs, idx, motion, res.reward, res.success, res.valid)
             else:

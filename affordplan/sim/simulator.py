@@ -23,7 +23,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from affordplan.errors import InputError
-from affordplan.geometry import check_pose, make_pose, transform_points
+from affordplan.geometry import check_pose, make_pose, relative_rotation, transform_points
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.arm import ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
@@ -140,6 +140,8 @@ class Simulator:
             self._pusher = ArmPusher(m, self.data, self._ik, CHUNK_STEPS * m.opt.timestep, self._safe_height)
         self._obstacle_geoms = np.array([m.geom(f"obstacle{i}").id for i in range(len(self.obstacles))], dtype=int)
         self._table_geom = m.geom("table").id
+        # The arm's fingertip may touch the table (it pushes low); other arm geoms may not.
+        self._fingertip_geom = m.geom("fingertip_c").id if pusher == "arm" else -1
         self._collisions: set[tuple[int, int]] = set()
         self._tracking: list[float] = []  # fingertip tracking errors of the current motion, metres
         # Called with the simulator after every control chunk (20 ms): for videos and probes.
@@ -278,8 +280,7 @@ class Simulator:
         self._servo(mid, touch, p.approach_time)
         pose = self.object_pose()
         moved = np.linalg.norm(pose[:3, 3] - pose_before[:3, 3])
-        R = pose[:3, :3] @ pose_before[:3, :3].T
-        turned = math.acos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))
+        turned, _ = relative_rotation(pose_before, pose)
         return bool(
             np.linalg.norm(self._pusher.tip() - touch) <= p.approach_position_tolerance
             and self._pusher.tilt() <= p.approach_tilt_tolerance
@@ -294,7 +295,7 @@ class Simulator:
 
     def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False) -> None:
         """Move the fingertip target linearly from ``start`` to ``end``; ``track`` logs the error."""
-        n_chunks = max(1, round(duration / (CHUNK_STEPS * self.model.opt.timestep)))
+        n_chunks = self._chunks(duration)
         for k in range(1, n_chunks + 1):
             target = start + (end - start) * (k / n_chunks)
             self._pusher.command(target)
@@ -305,7 +306,7 @@ class Simulator:
     def _settle(self, max_time: float) -> None:
         p = self.protocol
         still = 0
-        for _ in range(max(1, round(max_time / (CHUNK_STEPS * self.model.opt.timestep)))):
+        for _ in range(self._chunks(max_time)):
             self._step(CHUNK_STEPS)
             v = self.data.qvel[self._object_qvel:self._object_qvel + 6]
             if np.linalg.norm(v[:3]) < p.settle_linear_speed and np.linalg.norm(v[3:]) < p.settle_angular_speed:
@@ -314,6 +315,10 @@ class Simulator:
                     return
             else:
                 still = 0
+
+    def _chunks(self, duration: float) -> int:
+        """Number of control chunks (at least one) covering ``duration`` seconds."""
+        return max(1, round(duration / (CHUNK_STEPS * self.model.opt.timestep)))
 
     def _step(self, n: int) -> None:
         t0 = time.perf_counter()
@@ -339,7 +344,7 @@ class Simulator:
             other = pairs[:, b_col]
             hit = is_arm & (np.isin(other, self._obstacle_geoms) | (other == self._table_geom))
             for a, b in pairs[hit][:, [a_col, b_col]]:
-                if not (b == self._table_geom and self.model.geom(int(a)).name == "fingertip_c"):
+                if not (b == self._table_geom and a == self._fingertip_geom):
                     self._collisions.add((int(a), int(b)))
 
     def _safe_height(self) -> float:
