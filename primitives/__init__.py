@@ -5,11 +5,11 @@ trained skills (``load_skill``)."""
 from primitives import rewards
 
 
-def load_skill(name: str, weights=None):
+def load_skill(name: str, weights=None, success_weights=None):
     """The ``push``, ``roll`` or ``spin`` skill (see :mod:`primitives.skills`)."""
     from primitives.skills import load_skill as _load
 
-    return _load(name, weights)
+    return _load(name, weights, success_weights)
 
 
 __all__ = ["load_skill", "rewards"]

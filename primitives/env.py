@@ -1,15 +1,18 @@
-"""The one-step environment every primitive trains in (HACMan's, without the goal).
+"""The one-step environment every primitive trains in (HACMan's, with the skill parameter as its goal).
 
 ``reset`` draws an object (from a procedural split, a fixed list, or the seed's seven; a drawn object
 serves ``episodes_per_object`` consecutive episodes, since building its model costs ~80 ms against
 ~12 ms for a primitive), one of its resting states (by its probability), a position in the middle
 of the workspace and a yaw, lets it settle and returns its point cloud. ``step`` takes a contact
 point index and a 3-D motion in [-1, 1], executes the primitive in the finger sim and returns
-``-L`` of the seed's objective.
+``-L`` of the objective. With probability ``p_params`` an episode asks for a parameter (a push
+direction, a spin angle, a roll target; :mod:`primitives.params`) and the parameterised objective
+applies; otherwise the seed's.
 
-Observation, per point (``(n_points, 6)`` float32): ``(x - cx, y - cy, z, nx, ny, nz)``: position
-relative to the cloud's centroid on the table plane (the policy is translation invariant in the
-plane; height above the table matters), and the outward normal. World frame; yaw is randomised at
+Observation, per point (``(n_points, 9)`` float32): ``(x - cx, y - cy, z, nx, ny, nz, fx, fy, fz)``:
+position relative to the cloud's centroid on the table plane (the policy is translation invariant in
+the plane; height above the table matters), the outward normal, and the goal flow ``T_param p - p``
+the parameter asks for (zero for the seed's objective). World frame, metres; yaw is randomised at
 reset, so the policy must learn rotation on its own.
 """
 
@@ -22,11 +25,12 @@ import numpy as np
 
 from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.sim.simulator import Outcome, Simulator
+from primitives import params as skill_params
 from primitives import rewards
 
 PRIMITIVES = ("push", "roll", "spin")
 SEED_SEVEN = ("cube", "mug", "tape", "planter_1", "planter_2", "pill_bottle", "lunch_box")
-OBS_DIM = 6
+OBS_DIM = 9
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,7 @@ class EnvConfig:
     xy_range: tuple[tuple[float, float], tuple[float, float]] = ((0.45, 0.6), (-0.1, 0.1))
     sim_cache: int = 48  # simulators kept alive per environment (LRU)
     episodes_per_object: int = 8  # consecutive episodes on one drawn object: amortises its setup
+    p_params: float = 0.0  # probability that an episode asks for a parameter (0: the seed's objective)
 
 
 @dataclass
@@ -52,16 +57,31 @@ class StepResult:
     success: bool
     valid: bool
     outcome: Outcome
+    params: dict | None = None
 
 
-def observation(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Per-point features of a world-frame cloud (see the module docstring)."""
-    obs = np.empty((len(points), OBS_DIM), dtype=np.float32)
+def observation(points: np.ndarray, normals: np.ndarray, flow: np.ndarray | None = None) -> np.ndarray:
+    """Per-point features of a world-frame cloud and its goal flow (see the module docstring)."""
+    obs = np.zeros((len(points), OBS_DIM), dtype=np.float32)
     centre = points[:, :2].mean(axis=0)
     obs[:, :2] = points[:, :2] - centre
     obs[:, 2] = points[:, 2]
-    obs[:, 3:] = normals
+    obs[:, 3:6] = normals
+    if flow is not None:
+        obs[:, 6:9] = flow
     return obs
+
+
+def skill_observation(sim: Simulator, skill: str, params: dict | None, n_points: int,
+                      state: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
+    """Cloud, normals, observation and checked params of a skill about to act in ``sim``."""
+    pose = sim.object_pose()
+    if state is None:
+        state = sim.obj.classify(pose)
+    params = skill_params.check(skill, params, sim.obj, state)
+    points, normals = sim.point_cloud(n_points)
+    flow = skill_params.goal_flow(skill, params, points, pose, sim.obj)
+    return points, normals, observation(points, normals, flow), params
 
 
 class PrimitiveEnv:
@@ -78,6 +98,7 @@ class PrimitiveEnv:
         self.points = np.zeros((0, 3))
         self.normals = np.zeros((0, 3))
         self.object_key: object = None
+        self.params: dict | None = None
         self._episodes_left = 0
 
     # ------------------------------------------------------------------ objects
@@ -106,8 +127,11 @@ class PrimitiveEnv:
         return sim
 
     # ---------------------------------------------------------------- episode
-    def reset(self, object_key=None, resting_state: int | None = None) -> np.ndarray:
-        """Start an episode; returns the observation ``(n_points, 6)``."""
+    def reset(self, object_key=None, resting_state: int | None = None, params="random") -> np.ndarray:
+        """Start an episode; returns the observation ``(n_points, 9)``.
+
+        ``params``: ``"random"`` draws one (see ``EnvConfig.p_params``); a dict or ``None`` is used as given.
+        """
         if object_key is not None:
             key = object_key
         elif self._episodes_left > 0 and self.object_key is not None:
@@ -126,17 +150,22 @@ class PrimitiveEnv:
         sim.reset(resting_state=resting_state, xy=(self.rng.uniform(x0, x1), self.rng.uniform(y0, y1)),
                   yaw=self.rng.uniform(-np.pi, np.pi))
         self.sim, self.object_key = sim, key
-        self.points, self.normals = sim.point_cloud(self.config.n_points)
-        return observation(self.points, self.normals)
+        state = sim.obj.classify(sim.object_pose())
+        if isinstance(params, str) and params == "random":
+            params = skill_params.sample(self.config.primitive, self.rng, sim.obj, state, self.config.p_params)
+        self.points, self.normals, obs, self.params = skill_observation(
+            sim, self.config.primitive, params, self.config.n_points, state)
+        return obs
 
     def step(self, index: int, motion: np.ndarray) -> StepResult:
         """Execute the primitive at point ``index`` with ``motion``; the episode ends here."""
         assert self.sim is not None, "call reset() first"
         out = self.sim.execute(self.points[index], motion, normal=self.normals[index])
-        name = self.config.primitive
-        reward = rewards.reward(name, out.pose_before, out.pose_after)
-        success = rewards.SUCCESSES[name](out.pose_before, out.pose_after)
-        return StepResult(reward=reward, success=bool(success and out.valid), valid=out.valid, outcome=out)
+        name, obj = self.config.primitive, self.sim.obj
+        reward = -rewards.loss(name, out.pose_before, out.pose_after, self.params, obj)
+        success = rewards.success(name, out.pose_before, out.pose_after, self.params, obj)
+        return StepResult(reward=reward, success=bool(success and out.valid), valid=out.valid, outcome=out,
+                          params=self.params)
 
     def close(self) -> None:
         for sim in self._sims.values():

@@ -24,7 +24,7 @@ import torch
 from tqdm import tqdm
 
 from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
-from primitives.networks import HybridActorCritic
+from primitives.networks import HybridActorCritic, widen_input
 
 # The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
 SEED_FIG5 = {
@@ -50,7 +50,7 @@ def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActo
     if isinstance(state, dict) and "model" in state:
         state = state["model"]
     model = HybridActorCritic()
-    model.load_state_dict(state)
+    model.load_state_dict(widen_input(state))
     model.eval()
     return model
 
@@ -68,6 +68,7 @@ class EvalResult:
     objects: str
     per_object: dict[str, list[bool]] = field(default_factory=dict)
     invalid: int = 0
+    params: str = "none"
 
     @property
     def success_rate(self) -> float:
@@ -79,21 +80,27 @@ class EvalResult:
 
     def as_dict(self) -> dict:
         return dict(primitive=self.primitive, objects=self.objects, success=self.success_rate,
-                    trials=sum(len(v) for v in self.per_object.values()), invalid=self.invalid,
+                    trials=sum(len(v) for v in self.per_object.values()), invalid=self.invalid, params=self.params,
                     per_object=self.rates())
 
 
 def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str, ...] = "random",
-             trials: int = 200, seed: int = 1234, progress: bool = True) -> EvalResult:
-    """Success over ``trials`` stable starts (per object for ``seed7`` and paths)."""
+             trials: int = 200, seed: int = 1234, progress: bool = True, p_params: float = 0.0) -> EvalResult:
+    """Success over ``trials`` stable starts (per object for ``seed7`` and paths).
+
+    ``p_params``: the share of trials that ask for a random parameter (0: the seed's objective; 1:
+    every trial parameterised, judged by the parameterised criterion).
+    """
     if objects == "random":
-        cfg, plan = EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1), [None] * trials
+        cfg = EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1, p_params=p_params)
+        plan = [None] * trials
     else:
         names = SEED_SEVEN if objects == "seed7" else tuple(objects)
-        cfg = EnvConfig(primitive, objects=names, episodes_per_object=1)
+        cfg = EnvConfig(primitive, objects=names, episodes_per_object=1, p_params=p_params)
         plan = [n for n in names for _ in range(trials)]
     env = PrimitiveEnv(cfg, seed=seed)
-    result = EvalResult(primitive, objects if isinstance(objects, str) else "paths")
+    result = EvalResult(primitive, objects if isinstance(objects, str) else "paths",
+                        params={0.0: "none", 1.0: "random"}.get(p_params, f"p={p_params:.2f}"))
     for key in tqdm(plan, desc=f"evaluate {primitive}", disable=not progress, unit="trial", mininterval=2.0):
         obs = env.reset(object_key=key)
         idx, motion, _ = greedy_action(model, obs)
@@ -185,6 +192,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--trials", type=int, default=200)
     p.add_argument("--objects", nargs="+", default=["random"], help="random | seed7 | mesh paths")
     p.add_argument("--seed", type=int, default=1234)
+    p.add_argument("--params", choices=["none", "random"], default="none",
+                   help="none: the seed's objective; random: every trial asks for a random parameter")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--plot", default=None, help="write bar charts (the seed's Fig. 3 / Fig. 5) here")
     p.add_argument("--critic-map", default=None, help="write the critic map figure (the seed's Fig. 2) here")
@@ -196,7 +205,8 @@ def main(argv: list[str] | None = None) -> int:
     torch.set_num_threads(1)
     model = load_policy(args.weights, args.primitive)
     objects = args.objects[0] if args.objects[0] in ("random", "seed7") else tuple(args.objects)
-    result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json)
+    result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
+                      p_params=1.0 if args.params == "random" else 0.0)
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
     else:

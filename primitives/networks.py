@@ -9,6 +9,10 @@
 
 The contact is chosen from the critic map: ``softmax(Q / T)`` over points with epsilon-greedy
 exploration in training, the argmax at evaluation (HACMan's rule).
+
+Input per point: 9 features (position, normal, goal flow; :mod:`primitives.env`). Weights trained on
+the first 6 alone (the seed's objective, before parameters) load through :func:`widen_input`, which
+gives the goal-flow inputs zero weight: the network computes exactly what it did before.
 """
 
 from __future__ import annotations
@@ -16,11 +20,14 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+IN_DIM = 9  # per-point input: position (3), normal (3), goal flow (3)
+_FIRST_LAYER = "backbone.local.0.weight"
+
 
 class PointNetBackbone(nn.Module):
     """``(B, N, in_dim)`` -> per-point features ``(B, N, feat_dim)``."""
 
-    def __init__(self, in_dim: int = 6, local_dim: int = 128, global_dim: int = 256, feat_dim: int = 128):
+    def __init__(self, in_dim: int = IN_DIM, local_dim: int = 128, global_dim: int = 256, feat_dim: int = 128):
         super().__init__()
         self.local = nn.Sequential(nn.Linear(in_dim, 64), nn.ReLU(), nn.Linear(64, local_dim), nn.ReLU())
         self.global_mlp = nn.Sequential(nn.Linear(local_dim, global_dim), nn.ReLU())
@@ -42,7 +49,7 @@ def _mlp(in_dim: int, out_dim: int, hidden: int = 128) -> nn.Sequential:
 class HybridActorCritic(nn.Module):
     """Actor map and twin critic maps on a shared point-cloud backbone."""
 
-    def __init__(self, in_dim: int = 6, feat_dim: int = 128, action_dim: int = 3):
+    def __init__(self, in_dim: int = IN_DIM, feat_dim: int = 128, action_dim: int = 3):
         super().__init__()
         self.backbone = PointNetBackbone(in_dim, feat_dim=feat_dim)
         self.actor = _mlp(feat_dim, action_dim)
@@ -78,3 +85,13 @@ def choose_contact(q: torch.Tensor, temperature: float, epsilon: float, generato
     probs = torch.softmax(q / temperature, dim=1)
     probs = (1.0 - epsilon) * probs + epsilon / q.shape[1]
     return torch.multinomial(probs, 1, generator=generator).squeeze(1)
+
+
+def widen_input(state: dict[str, torch.Tensor], in_dim: int = IN_DIM) -> dict[str, torch.Tensor]:
+    """A state dict whose first layer reads ``in_dim`` inputs; added inputs get zero weight."""
+    w = state.get(_FIRST_LAYER)
+    if w is None or w.shape[1] >= in_dim:
+        return state
+    state = dict(state)
+    state[_FIRST_LAYER] = torch.cat([w, torch.zeros(w.shape[0], in_dim - w.shape[1], dtype=w.dtype)], dim=1)
+    return state

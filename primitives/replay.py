@@ -10,7 +10,7 @@ import numpy as np
 
 
 class ReplayBuffer:
-    def __init__(self, capacity: int, n_points: int, obs_dim: int = 6):
+    def __init__(self, capacity: int, n_points: int, obs_dim: int = 9):
         self.capacity = int(capacity)
         self.obs = np.zeros((self.capacity, n_points, obs_dim), dtype=np.float16)
         self.index = np.zeros(self.capacity, dtype=np.int32)

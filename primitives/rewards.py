@@ -12,6 +12,18 @@ rotation):
   ``|w.z| >= cos 45deg``.
 
 The reward of a primitive is ``-L``.
+
+Parameterised variants (:func:`loss` and :func:`success` with ``params``; see :mod:`primitives.params`)
+generalise these and reduce to them when ``params`` is ``None``:
+
+- push ``{"direction": a}``, ``d = (cos a, sin a, 0)``: ``L = 20 max(0.05 - p.d, 0) + theta/180 +
+  10 |p_xy - (p.d) d|`` (progress along ``d`` saturating at 5 cm, turning, sideways slip); success
+  ``|p| >= 0.05``, ``theta < 5`` and ``p_xy`` within 15 deg of ``d``.
+- spin ``{"angle": a}``: with ``phi`` the signed turn about +z (``theta sign(w.z)``, degrees),
+  ``L = 1 - |w.z| + |phi - a|/30 + 2.5 |p_xy|``; success ``|phi - a| <= 10`` and ``|w.z| >= cos 45deg``.
+- roll ``{"target": j}``: with ``tilt`` the angle (degrees) between the pose's up-vector and the
+  nearest up-vector of state ``j``, ``L = tilt/60 + 0.5 |p_xy|``; success: the settled pose is in
+  state ``j``.
 """
 
 from __future__ import annotations
@@ -22,11 +34,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from affordplan.geometry import check_pose, relative_rotation
+from affordplan.objects.model import ObjectModel
 
 PUSH_DISTANCE = 0.05  # metres
 PUSH_MAX_ROTATION_DEG = 5.0
 ROLL_MIN_ROTATION_DEG = 60.0
 SPIN_MIN_ROTATION_DEG = 30.0
+PUSH_DIRECTION_TOLERANCE_DEG = 15.0
+PUSH_SLIP_WEIGHT = 10.0  # per metre of sideways slip
+SPIN_ANGLE_TOLERANCE_DEG = 10.0
 AXIS_TOLERANCE_DEG = 45.0
 # Thresholds are inclusive; this slack absorbs floating-point error in the rotation angle so that a
 # rotation of exactly 60 deg (say) counts as reaching 60 deg.
@@ -99,3 +115,63 @@ SUCCESSES = {"push": push_success, "roll": roll_success, "spin": spin_success}
 def reward(primitive: str, T0: np.ndarray, T1: np.ndarray) -> float:
     """``-L`` of the named primitive (``"push"``, ``"roll"`` or ``"spin"``)."""
     return -LOSSES[primitive](T0, T1)
+
+
+# ------------------------------------------------------------------------ parameterised objectives
+def signed_turn_deg(m: Motion) -> float:
+    """The turn about +z in degrees, signed (counter-clockwise positive)."""
+    return m.theta_deg * (1.0 if m.w[2] >= 0 else -1.0)
+
+
+def _push_dir(T0, T1, direction: float) -> tuple[float, bool]:
+    m = motion(T0, T1)
+    d = np.array([math.cos(direction), math.sin(direction), 0.0])
+    along = float(m.p @ d)
+    slip = float(np.linalg.norm(m.p[:2] - along * d[:2]))
+    loss = 20.0 * max(PUSH_DISTANCE - along, 0.0) + m.theta_deg / 180.0 + PUSH_SLIP_WEIGHT * slip
+    off = math.degrees(math.atan2(slip, along)) if m.p_xy > 0 else 180.0
+    ok = (np.linalg.norm(m.p) >= PUSH_DISTANCE - _EPS and m.theta_deg < PUSH_MAX_ROTATION_DEG
+          and off <= PUSH_DIRECTION_TOLERANCE_DEG + _EPS)
+    return loss, bool(ok)
+
+
+def _spin_angle(T0, T1, angle: float) -> tuple[float, bool]:
+    m = motion(T0, T1)
+    err = abs(signed_turn_deg(m) - math.degrees(angle))
+    loss = 1.0 - m.wz + err / SPIN_MIN_ROTATION_DEG + 2.5 * m.p_xy
+    ok = err <= SPIN_ANGLE_TOLERANCE_DEG + _EPS and m.wz >= math.cos(math.radians(AXIS_TOLERANCE_DEG)) - _EPS
+    return loss, bool(ok)
+
+
+def _roll_target(T0, T1, target: int, obj: ObjectModel) -> tuple[float, bool]:
+    m = motion(T0, T1)
+    tilt = math.degrees(obj.tilt_from_state(T1, target))
+    return tilt / ROLL_MIN_ROTATION_DEG + 0.5 * m.p_xy, obj.classify(T1) == target
+
+
+def _parameterised(primitive: str, T0, T1, params: dict, obj: ObjectModel | None) -> tuple[float, bool]:
+    if primitive == "push":
+        return _push_dir(T0, T1, params["direction"])
+    if primitive == "spin":
+        return _spin_angle(T0, T1, params["angle"])
+    if primitive == "roll":
+        if obj is None:
+            raise ValueError("a roll target needs the object model (obj=...)")
+        return _roll_target(T0, T1, params["target"], obj)
+    raise ValueError(f"unknown primitive {primitive!r}")
+
+
+def loss(primitive: str, T0: np.ndarray, T1: np.ndarray, params: dict | None = None,
+         obj: ObjectModel | None = None) -> float:
+    """``L`` of the named primitive; the seed's when ``params`` is ``None``."""
+    if params is None:
+        return LOSSES[primitive](T0, T1)
+    return _parameterised(primitive, T0, T1, params, obj)[0]
+
+
+def success(primitive: str, T0: np.ndarray, T1: np.ndarray, params: dict | None = None,
+            obj: ObjectModel | None = None) -> bool:
+    """The success test of the named primitive; the seed's when ``params`` is ``None``."""
+    if params is None:
+        return SUCCESSES[primitive](T0, T1)
+    return _parameterised(primitive, T0, T1, params, obj)[1]

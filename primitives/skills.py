@@ -1,12 +1,15 @@
-"""Trained primitives as skills a planner or a user can call on a simulator.
+"""Trained primitives as parameterised skills a planner or a user can call on a simulator.
 
     from primitives import load_skill
-    push = load_skill("push")            # the shipped weights (primitives/weights/push.pt)
-    contact, motion = push.act(sim)      # greedy: argmax of the critic map, the actor's motion
-    outcome = push.execute(sim)          # Outcome with .success by the seed's criterion
+    push = load_skill("push")                                   # shipped weights
+    push.success_probability(sim, {"direction": 0.0})           # learned P(success), no physics run
+    outcome = push.execute(sim, {"direction": 0.0})             # Outcome with .success
+    contact, motion = push.act(sim, {"direction": 0.0})         # what the policy would do
 
-This release runs the seed's unparameterised objectives (``params=None``); parameterised skills and
-learned success models are the next step.
+Parameters (:mod:`primitives.params`): push ``{"direction": rad}`` (world heading), spin
+``{"angle": rad}`` (signed, 15-45 deg), roll ``{"target": state index}`` (one roll away); ``None`` is
+the seed's objective. ``Outcome.success`` applies the matching criterion (:func:`primitives.rewards.success`).
+The policy acts greedily, so ``act`` and ``execute`` are deterministic for a given cloud.
 """
 
 from __future__ import annotations
@@ -19,42 +22,64 @@ import torch
 from affordplan.errors import InputError
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
-from primitives.env import PRIMITIVES, observation
+from primitives.env import PRIMITIVES, skill_observation
 from primitives.evaluate import greedy_action, load_policy
 from primitives.networks import HybridActorCritic
+from primitives.success import SuccessModel, load_success_net
 
 
 class Skill:
-    """A trained primitive acting greedily on a simulator's point cloud."""
+    """A trained primitive acting greedily on a simulator's point cloud, with its success model."""
 
-    def __init__(self, name: str, model: HybridActorCritic, n_points: int = 256):
+    def __init__(self, name: str, model: HybridActorCritic, n_points: int = 256,
+                 success_weights: str | os.PathLike | None = None):
         self.name = name
         self.model = model
         self.n_points = n_points
+        self._success_weights = success_weights
+        self._success: SuccessModel | None = None
 
-    def _decide(self, sim: Simulator, params) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        if params is not None:
-            raise InputError(f"the {self.name} skill of this release takes no parameters (got {params!r})")
-        points, normals = sim.point_cloud(self.n_points)
-        idx, motion, _ = greedy_action(self.model, observation(points, normals))
-        return points[idx], normals[idx], motion
+    def observe(self, sim: Simulator, params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
+        """Cloud, normals, the policy's observation and the checked params (raises InputError)."""
+        return skill_observation(sim, self.name, params, self.n_points)
+
+    def _decide(self, sim: Simulator, params) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
+        points, normals, obs, params = self.observe(sim, params)
+        idx, motion, _ = greedy_action(self.model, obs)
+        return points[idx], normals[idx], motion, params
 
     def act(self, sim: Simulator, params=None) -> tuple[np.ndarray, np.ndarray]:
         """The contact point (world, metres) and motion in [-1, 1]^3 the policy picks."""
-        contact, _, motion = self._decide(sim, params)
+        contact, _, motion, _ = self._decide(sim, params)
         return contact, motion
 
     def execute(self, sim: Simulator, params=None) -> Outcome:
-        """Act and execute; ``Outcome.success`` is the seed's criterion (and the sample valid)."""
-        contact, normal, motion = self._decide(sim, params)
+        """Act and execute; ``Outcome.success``: the criterion for ``params`` was met (and the sample valid)."""
+        contact, normal, motion, params = self._decide(sim, params)
         out = sim.execute(contact, motion, normal=normal)
-        out.success = bool(out.valid and rewards.SUCCESSES[self.name](out.pose_before, out.pose_after))
+        out.success = bool(out.valid and rewards.success(self.name, out.pose_before, out.pose_after, params, sim.obj))
         return out
 
+    @property
+    def success_model(self) -> SuccessModel:
+        if self._success is None:
+            self._success = SuccessModel(self.model, load_success_net(self.name, self._success_weights))
+        return self._success
 
-def load_skill(name: str, weights: str | os.PathLike | None = None) -> Skill:
-    """The ``push``, ``roll`` or ``spin`` skill, from the shipped weights or a given file."""
+    def success_probability(self, sim: Simulator, params=None) -> float:
+        """Predicted probability that ``execute(sim, params)`` succeeds now (no physics is run)."""
+        _, _, obs, _ = self.observe(sim, params)
+        return float(self.success_model.predict(obs))
+
+    def success_probability_obs(self, obs: np.ndarray) -> np.ndarray:
+        """Predicted P(success) for observations built with :func:`primitives.env.skill_observation`."""
+        return self.success_model.predict(obs)
+
+
+def load_skill(name: str, weights: str | os.PathLike | None = None,
+               success_weights: str | os.PathLike | None = None) -> Skill:
+    """The ``push``, ``roll`` or ``spin`` skill, from the shipped weights or given files."""
     if name not in PRIMITIVES:
         raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
-    return Skill(name, load_policy(weights, name))
+    return Skill(name, load_policy(weights, name), success_weights=success_weights)

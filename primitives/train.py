@@ -14,6 +14,11 @@ Read top to bottom, CleanRL style. Choices and why:
   all points (HACMan's actor objective), with delayed updates (TD3).
 - **Shared backbone, trained by the critic.** One PointNet backbone feeds both heads; the actor sees
   detached features. One backbone pass per cloud halves the cost on a CPU.
+- **Parameters as goal flow.** With probability ``p_params`` an episode asks for a parameter (push
+  direction, spin angle, roll target) and the observation carries, per point, the displacement it
+  asks for (HACMan's goal flow); otherwise the flow is zero and the seed's objective applies. One
+  policy serves both. ``--init`` warm-starts from earlier weights (weights without the flow inputs
+  are widened with zero weights, so the run starts from what they did).
 - **Invalid samples are dropped.** Primitives flagged by the physics guards never enter the replay.
 - **Workers.** ``--workers K`` runs K rollout processes (one torch thread each) that act with the
   latest weights and send transitions to this learner; ``--workers 0`` collects in-process and is
@@ -59,6 +64,8 @@ class TrainConfig:
     n_points: int = 256  # object points per cloud (HACMan: 400); the maps are point-count agnostic
     objects: str | tuple[str, ...] = "train"  # the procedural training split, or catalogue names
     n_objects: int = 500
+    p_params: float = 0.75  # share of episodes that ask for a parameter (0: the seed's objective only)
+    init: str | None = None  # weights to start from (ignored on --resume)
     batch_size: int = 32
     lr: float = 3e-4
     temperature: float = 0.1  # softmax temperature over the critic map (HACMan: 0.1)
@@ -75,7 +82,8 @@ class TrainConfig:
 
 
 def env_config(cfg: TrainConfig) -> EnvConfig:
-    return EnvConfig(cfg.primitive, objects=cfg.objects, n_objects=cfg.n_objects, n_points=cfg.n_points)
+    return EnvConfig(cfg.primitive, objects=cfg.objects, n_objects=cfg.n_objects, n_points=cfg.n_points,
+                     p_params=cfg.p_params)
 
 
 # ---------------------------------------------------------------------------- acting
@@ -155,6 +163,10 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
     torch.set_num_threads(cfg.torch_threads)
     torch.manual_seed(cfg.seed)
     model = HybridActorCritic()
+    if cfg.init and not (resume and (out / "checkpoint.pt").exists()):
+        from primitives.evaluate import load_policy
+
+        model.load_state_dict(load_policy(cfg.init, cfg.primitive).state_dict())
     critic_params = [*model.backbone.parameters(), *model.q1.parameters(), *model.q2.parameters()]
     opt_critic = torch.optim.Adam(critic_params, lr=cfg.lr)
     opt_actor = torch.optim.Adam(model.actor.parameters(), lr=cfg.lr)
@@ -331,6 +343,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, help="run folder (default: runs/PRIMITIVE)")
     p.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
     p.add_argument("--max-minutes", type=float, default=d.max_minutes, help="wall-time budget")
+    p.add_argument("--p-params", type=float, default=d.p_params,
+                   help="share of episodes that ask for a parameter (default: %(default)s; 0 = seed objective)")
+    p.add_argument("--init", default=None, help="start from these weights (e.g. primitives/weights/push.pt)")
     p.add_argument("--batch-size", type=int, default=d.batch_size)
     p.add_argument("--lr", type=float, default=d.lr)
     p.add_argument("--replay-size", type=int, default=d.replay_size)
@@ -348,6 +363,7 @@ def main(argv: list[str] | None = None) -> int:
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
         checkpoint_minutes=args.checkpoint_minutes, n_points=args.n_points, torch_threads=args.torch_threads,
+        p_params=args.p_params, init=args.init,
     )
     summary = train(cfg, resume=args.resume)
     print(json.dumps({k: v for k, v in summary.items() if k != "rss_samples"}, indent=2))

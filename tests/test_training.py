@@ -19,7 +19,7 @@ from primitives.train import TrainConfig, train
 def test_maps_are_per_point_and_permutation_equivariant():
     torch.manual_seed(0)
     model = HybridActorCritic().eval()
-    obs = torch.randn(2, 64, 6)
+    obs = torch.randn(2, 64, 9)
     actions, q = model.maps(obs)
     assert actions.shape == (2, 64, 3) and q.shape == (2, 64)
     assert actions.abs().max() <= 1.0
@@ -40,7 +40,7 @@ def test_replay_memory_is_fixed_and_ring_overwrites():
     buf = ReplayBuffer(capacity=10, n_points=8)
     before = buf.nbytes
     for i in range(25):
-        buf.add(np.full((8, 6), i, dtype=np.float32), i % 8, np.zeros(3), float(i), i % 2 == 0)
+        buf.add(np.full((8, 9), i, dtype=np.float32), i % 8, np.zeros(3), float(i), i % 2 == 0)
     assert buf.nbytes == before and buf.size == 10
     assert set(buf.reward.astype(int)) == set(range(15, 25))
     restored = ReplayBuffer(capacity=10, n_points=8)
@@ -51,7 +51,7 @@ def test_replay_memory_is_fixed_and_ring_overwrites():
 def test_env_step_returns_the_seed_reward():
     env = PrimitiveEnv(EnvConfig("push", objects=("cube",), n_points=64), seed=0)
     obs = env.reset()
-    assert obs.shape == (64, 6) and obs.dtype == np.float32
+    assert obs.shape == (64, 9) and obs.dtype == np.float32
     assert np.allclose(obs[:, :2].mean(axis=0), 0.0, atol=1e-5)
     res = env.step(0, np.array([1.0, 0.0, 0.0]))
     from primitives import rewards
@@ -76,7 +76,7 @@ def test_corrupt_checkpoint_gives_a_clear_error(tmp_path):
 def _cube_config(out, steps: int) -> TrainConfig:
     return TrainConfig(primitive="push", steps=steps, workers=0, seed=0, out=str(out), objects=("cube",),
                        learning_starts=100, replay_size=1000, n_points=128, replay_ratio=48.0,
-                       checkpoint_minutes=60.0)
+                       checkpoint_minutes=60.0, p_params=0.0)
 
 
 def test_checkpoint_resume_round_trips(tmp_path):
@@ -156,8 +156,11 @@ def test_skill_acts_and_judges_with_given_weights(tmp_path):
     assert contact.shape == (3,) and np.all(np.abs(motion) <= 1.0)
     out = skill.execute(sim)
     assert out.success == (out.valid and rewards_push_success(out))
-    with pytest.raises(InputError):
-        skill.act(sim, params={"direction": 0.0})
+    contact_dir, _ = skill.act(sim, params={"direction": 0.0})  # the goal flow changes the input
+    assert contact_dir.shape == (3,)
+    for bad in ({"direction": float("nan")}, {"angle": 0.3}, {"direction": "east"}, [0.0]):
+        with pytest.raises(InputError):
+            skill.act(sim, params=bad)
     with pytest.raises(InputError):
         load_skill("jump")
 

@@ -1,0 +1,142 @@
+"""Skill parameters: what each skill can be asked, checking it, drawing it, and its goal flow.
+
+- push: ``{"direction": a}``, a world-frame heading on the table in radians (any value, wrapped);
+- spin: ``{"angle": a}``, a signed turn about the vertical in radians, ``15 <= |a| <= 45`` degrees
+  (bigger turns are chained by the planner);
+- roll: ``{"target": j}``, the index of a resting state one roll away from the current one.
+
+``None`` is the seed's unparameterised objective.
+
+**Goal flow** (how a parameter reaches the policy, as HACMan conditions on a goal): for each cloud
+point ``p`` the displacement ``T_param p - p`` (metres, world frame) that the parameter asks for,
+where ``T_param`` is the rigid motion the parameter names: a 5 cm translation along the direction
+(push), a rotation by the angle about the vertical through the centre of mass (spin), or the
+smallest tip that brings the target state's up-vector to +z, about the centre of mass, plus the
+change of height (roll). ``None`` asks for nothing: the flow is zero.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from affordplan.errors import InputError
+from affordplan.geometry import rot_z, wrap_angle
+from affordplan.objects.model import ObjectModel
+
+PUSH_STEP = 0.05  # metres: what one push is asked to move the object
+SPIN_MIN = math.radians(15.0)
+SPIN_MAX = math.radians(45.0)
+# A state is one roll away when its up-vector is within this angle of the current one (a cube's
+# neighbouring faces are 90 deg apart, its opposite face 180 deg: two rolls).
+ROLL_MAX_TIP = math.radians(135.0)
+WORLD_Z = np.array([0.0, 0.0, 1.0])
+
+
+def roll_targets(obj: ObjectModel, state: int) -> list[int]:
+    """Resting states one roll away from ``state`` (excluding itself)."""
+    states = obj.resting_states
+    here = states[state].member_ups
+    out = []
+    for s in states:
+        if s.index == state:
+            continue
+        cos = float(np.max(here @ s.member_ups.T))
+        if math.acos(min(1.0, max(-1.0, cos))) <= ROLL_MAX_TIP + 1e-9:
+            out.append(s.index)
+    return out
+
+
+def check(skill: str, params, obj: ObjectModel | None = None, state: int | None = None) -> dict | None:
+    """Validated, normalised parameters (or ``None``); raises :class:`InputError` otherwise.
+
+    ``obj`` and ``state`` (the current resting state) are needed to check a roll target.
+    """
+    if params is None:
+        return None
+    if not isinstance(params, dict):
+        raise InputError(f"{skill} params must be a dict or None, got {params!r}")
+    key = {"push": "direction", "spin": "angle", "roll": "target"}.get(skill)
+    if key is None:
+        raise InputError(f"unknown skill {skill!r}")
+    if set(params) != {key}:
+        raise InputError(f"{skill} takes params {{{key!r}: ...}}, got {params!r}")
+    value = params[key]
+    if skill == "roll":
+        if not isinstance(value, (int, np.integer)) or isinstance(value, bool):
+            raise InputError(f"roll target must be a resting-state index, got {value!r}")
+        if obj is not None:
+            n = len(obj.resting_states)
+            if not 0 <= value < n:
+                raise InputError(f"roll target {value} is not a resting state of {obj.name} (it has {n})")
+            if state is not None and value not in roll_targets(obj, state):
+                raise InputError(f"resting state {value} of {obj.name} is not one roll away from state {state} "
+                                 f"(one roll away: {roll_targets(obj, state)})")
+        return {"target": int(value)}
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{skill} {key} must be a number in radians, got {value!r}") from None
+    if not math.isfinite(value):
+        raise InputError(f"{skill} {key} must be finite, got {value!r}")
+    if skill == "push":
+        return {"direction": wrap_angle(value)}
+    if not SPIN_MIN - 1e-9 <= abs(value) <= SPIN_MAX + 1e-9:
+        raise InputError(f"spin angle must be between {math.degrees(SPIN_MIN):.0f} and {math.degrees(SPIN_MAX):.0f} "
+                         f"degrees either way, got {math.degrees(value):.1f} deg (chain spins for more)")
+    return {"angle": value}
+
+
+def sample(skill: str, rng: np.random.Generator, obj: ObjectModel, state: int, p_params: float) -> dict | None:
+    """A random parameter for training and evaluation; ``None`` with probability ``1 - p_params``."""
+    if rng.random() >= p_params:
+        return None
+    if skill == "push":
+        return {"direction": float(rng.uniform(-math.pi, math.pi))}
+    if skill == "spin":
+        return {"angle": float(rng.choice([-1.0, 1.0]) * rng.uniform(SPIN_MIN, SPIN_MAX))}
+    targets = roll_targets(obj, state)
+    return {"target": int(rng.choice(targets))} if targets else None
+
+
+def roll_rotation(obj: ObjectModel, R_world_object: np.ndarray, target: int) -> np.ndarray:
+    """The smallest world-frame rotation (3x3) that brings resting state ``target`` face-down."""
+    ups_world = obj.resting_states[target].member_ups @ np.asarray(R_world_object).T
+    up = ups_world[int(np.argmax(ups_world[:, 2]))]  # the member needing the smallest tip
+    rot, _ = Rotation.align_vectors(WORLD_Z[None], up[None])
+    return rot.as_matrix()
+
+
+def goal_transform(skill: str, params: dict | None, T_world_object: np.ndarray,
+                   obj: ObjectModel | None = None) -> np.ndarray:
+    """``T_param``: the 4x4 world-frame rigid motion a parameter asks for (identity for ``None``)."""
+    T = np.eye(4)
+    if params is None:
+        return T
+    c = np.asarray(T_world_object)[:3, 3]
+    if skill == "push":
+        a = params["direction"]
+        T[:3, 3] = PUSH_STEP * np.array([math.cos(a), math.sin(a), 0.0])
+        return T
+    if skill == "spin":
+        R = rot_z(params["angle"])
+        dz = 0.0
+    else:
+        if obj is None:
+            raise InputError("a roll goal needs the object model")
+        R = roll_rotation(obj, np.asarray(T_world_object)[:3, :3], params["target"])
+        dz = obj.resting_states[params["target"]].height - c[2]
+    T[:3, :3] = R
+    T[:3, 3] = c - R @ c + np.array([0.0, 0.0, dz])
+    return T
+
+
+def goal_flow(skill: str, params: dict | None, points: np.ndarray, T_world_object: np.ndarray,
+              obj: ObjectModel | None = None) -> np.ndarray:
+    """Per-point displacement ``T_param p - p`` (``(n, 3)`` float32, metres, world frame)."""
+    if params is None:
+        return np.zeros((len(points), 3), dtype=np.float32)
+    T = goal_transform(skill, params, T_world_object, obj)
+    return (points @ T[:3, :3].T + T[:3, 3] - points).astype(np.float32)

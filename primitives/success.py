@@ -1,0 +1,360 @@
+"""Learned success models: ``P(success | point cloud, params)`` for a skill's own policy.
+
+    python -m primitives.success train push --rollouts 6000 --out runs/push_success
+    python -m primitives.success evaluate push --rollouts 1500 --plot push_reliability.png
+
+A success model answers "if this skill acts now, with this parameter, will it succeed?" for the
+planner, which asks it often. Choices and why:
+
+- **Same input as the policy, plus what the policy would do.** The model sees the observation the
+  policy sees (points, normals, goal flow) through a small PointNet (per-point MLP, max- and
+  mean-pool), and a summary of the policy's own decision on it: the chosen contact's critic value,
+  the spread of the critic map, the contact's position and normal and the chosen motion. These are
+  functions of the cloud and the parameter (the policy is deterministic at evaluation), and they
+  carry the critic's estimate of the outcome, which the model only has to calibrate and correct.
+- **Data** are greedy rollouts of the policy on the procedural training split (85 % with a random
+  parameter, 15 % the seed's objective); physics-guard failures are dropped as in training.
+- **Calibration.** After fitting (binary cross-entropy), Platt scaling (``sigmoid(a z + b)``) is fitted
+  on rollouts from held-out *training* objects; figures are reported on the procedural *test* split,
+  never seen by the policy or the model: ECE over 10 equal-width bins, Brier score, AUROC.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import nn
+from tqdm import tqdm
+
+from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
+from primitives.networks import HybridActorCritic
+
+WEIGHTS_DIR = Path(__file__).parent / "weights"
+N_DECISION = 13  # policy-decision features, see decision_features
+
+
+def decision_features(policy: HybridActorCritic, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The policy's greedy decision on a batch ``(B, N, 9)`` and its summary ``(B, 13)``.
+
+    Returns ``(index (B,), motion (B, 3), features (B, 13))``; the features are the chosen Q, the
+    map's max minus its mean, its std, a softmax-entropy, the contact's observation (position,
+    normal) and the motion.
+    """
+    actions, q = policy.maps(obs)
+    idx = q.argmax(dim=1)
+    rows = torch.arange(len(idx))
+    q_max = q[rows, idx]
+    probs = torch.softmax(q / 0.1, dim=1)
+    entropy = -(probs * torch.log(probs + 1e-12)).sum(dim=1) / np.log(q.shape[1])
+    motion = actions[rows, idx]
+    feats = torch.cat([torch.stack([q_max, q_max - q.mean(dim=1), q.std(dim=1), entropy], dim=1),
+                       obs[rows, idx, :6] * torch.tensor([10, 10, 10, 1, 1, 1.0]), motion], dim=1)
+    return idx, motion, feats
+
+
+class SuccessNet(nn.Module):
+    """Logit of success from an observation ``(B, N, 9)`` and decision features ``(B, 13)``."""
+
+    def __init__(self, in_dim: int = OBS_DIM, width: int = 64):
+        super().__init__()
+        self.points = nn.Sequential(nn.Linear(in_dim, width), nn.ReLU(), nn.Linear(width, 2 * width), nn.ReLU())
+        self.head = nn.Sequential(nn.Linear(4 * width + N_DECISION, 2 * width), nn.ReLU(),
+                                  nn.Linear(2 * width, width), nn.ReLU(), nn.Linear(width, 1))
+        # Platt scaling, fitted after training: p = sigmoid(a * logit + b).
+        self.register_buffer("platt", torch.tensor([1.0, 0.0]))
+
+    def logit(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+        x = obs * torch.tensor([10, 10, 10, 1, 1, 1, 20, 20, 20.0])  # metres -> ~unit scale
+        h = self.points(x)
+        g = torch.cat([h.amax(dim=1), h.mean(dim=1), decision], dim=1)
+        return self.head(g).squeeze(-1)
+
+    def forward(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+        """Calibrated probability of success ``(B,)``."""
+        return torch.sigmoid(self.platt[0] * self.logit(obs, decision) + self.platt[1])
+
+
+class SuccessModel:
+    """A skill's policy and its success model, answering queries on observations."""
+
+    def __init__(self, policy: HybridActorCritic, net: SuccessNet):
+        self.policy = policy.eval()
+        self.net = net.eval()
+
+    @torch.no_grad()
+    def predict(self, obs: np.ndarray) -> np.ndarray:
+        """P(success) for observations ``(N, 9)`` or ``(B, N, 9)``."""
+        x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
+        single = x.ndim == 2
+        x = x[None] if single else x
+        _, _, d = decision_features(self.policy, x)
+        p = self.net(x, d).numpy()
+        return p[0] if single else p
+
+
+# --------------------------------------------------------------------------------- data
+@dataclass
+class Rollouts:
+    obs: np.ndarray  # (n, N, 9) float16
+    decision: np.ndarray  # (n, 13) float32
+    success: np.ndarray  # (n,) bool
+    group: np.ndarray  # (n,) int: object id (for splits by object)
+    parameterised: np.ndarray  # (n,) bool
+
+    def __len__(self) -> int:
+        return len(self.success)
+
+    def subset(self, mask: np.ndarray) -> Rollouts:
+        return Rollouts(*(a[mask] for a in (self.obs, self.decision, self.success, self.group, self.parameterised)))
+
+    def save(self, path: str | os.PathLike) -> None:
+        np.savez_compressed(path, obs=self.obs, decision=self.decision, success=self.success, group=self.group,
+                            parameterised=self.parameterised)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Rollouts:
+        z = np.load(path)
+        return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"])
+
+
+@torch.no_grad()
+def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train", n_objects: int = 500,
+            seed: int = 0, p_params: float = 0.85, progress: bool = True) -> Rollouts:
+    """``n`` valid greedy rollouts of ``policy`` on a procedural split."""
+    env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
+                                 episodes_per_object=4), seed=seed)
+    obs_l, dec_l, succ_l, group_l, par_l = [], [], [], [], []
+    bar = tqdm(total=n, desc=f"rollouts {skill} ({split})", disable=not progress, unit="rollout", mininterval=2.0)
+    while len(succ_l) < n:
+        obs = env.reset()
+        x = torch.from_numpy(obs)[None]
+        idx, motion, dec = decision_features(policy, x)
+        res = env.step(int(idx[0]), motion[0].numpy().astype(np.float64))
+        if not res.valid:
+            continue
+        obs_l.append(obs.astype(np.float16))
+        dec_l.append(dec[0].numpy())
+        succ_l.append(res.success)
+        group_l.append(zlib.crc32(repr(env.object_key).encode()))
+        par_l.append(res.params is not None)
+        bar.update(1)
+    bar.close()
+    env.close()
+    return Rollouts(np.stack(obs_l), np.stack(dec_l).astype(np.float32), np.array(succ_l), np.array(group_l),
+                    np.array(par_l))
+
+
+# ------------------------------------------------------------------------------ metrics
+def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
+    """Expected calibration error over ``bins`` equal-width bins."""
+    p, y = np.asarray(p, float), np.asarray(y, float)
+    which = np.minimum((p * bins).astype(int), bins - 1)
+    total = 0.0
+    for b in range(bins):
+        m = which == b
+        if m.any():
+            total += m.mean() * abs(p[m].mean() - y[m].mean())
+    return float(total)
+
+
+def brier(p: np.ndarray, y: np.ndarray) -> float:
+    return float(np.mean((np.asarray(p, float) - np.asarray(y, float)) ** 2))
+
+
+def auroc(p: np.ndarray, y: np.ndarray) -> float:
+    """Area under the ROC curve (the Mann-Whitney statistic, ties counted half)."""
+    from scipy.stats import rankdata
+
+    y = np.asarray(y, bool)
+    n_pos, n_neg = int(y.sum()), int((~y).sum())
+    if n_pos == 0 or n_neg == 0:
+        return float("nan")
+    ranks = rankdata(p)
+    return float((ranks[y].sum() - n_pos * (n_pos + 1) / 2) / (n_pos * n_neg))
+
+
+def metrics(p: np.ndarray, y: np.ndarray) -> dict:
+    return dict(n=int(len(y)), success_rate=float(np.mean(y)), mean_prediction=float(np.mean(p)), ece=ece(p, y),
+                brier=brier(p, y), auroc=auroc(p, y))
+
+
+def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, title: str, bins: int = 10) -> None:
+    """Reliability diagram: measured success rate per predicted-probability bin, and the bin counts."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    which = np.minimum((np.asarray(p) * bins).astype(int), bins - 1)
+    centres = (np.arange(bins) + 0.5) / bins
+    rate = np.array([np.mean(y[which == b]) if np.any(which == b) else np.nan for b in range(bins)])
+    count = np.array([np.sum(which == b) for b in range(bins)])
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(4.5, 5.5), sharex=True, gridspec_kw=dict(height_ratios=[3, 1]))
+    ax.plot([0, 1], [0, 1], color="grey", linestyle="--", label="perfect calibration")
+    ax.bar(centres, rate, width=1 / bins, edgecolor="black", color="#d98c2b", alpha=0.8, label="measured")
+    ax.set_ylabel("measured success rate")
+    ax.set_ylim(0, 1)
+    m = metrics(p, y)
+    ax.set_title(f"{title}\nECE {m['ece']:.3f}  Brier {m['brier']:.3f}  AUROC {m['auroc']:.3f}  (n={m['n']})",
+                 fontsize=9)
+    ax.legend(fontsize=8, loc="upper left")
+    ax2.bar(centres, count, width=1 / bins, edgecolor="black", color="#888888")
+    ax2.set_xlabel("predicted P(success)")
+    ax2.set_ylabel("rollouts")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+# ----------------------------------------------------------------------------- training
+def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, lr: float = 1e-3,
+        calib_fraction: float = 0.2, progress: bool = True) -> tuple[SuccessNet, dict]:
+    """Train a :class:`SuccessNet` on rollouts; Platt-scale it on a held-out share of their objects."""
+    torch.manual_seed(seed)
+    rng = np.random.default_rng(seed)
+    groups = np.unique(data.group)
+    calib_groups = rng.choice(groups, size=max(1, int(calib_fraction * len(groups))), replace=False)
+    calib_mask = np.isin(data.group, calib_groups)
+    train, calib = data.subset(~calib_mask), data.subset(calib_mask)
+    net = SuccessNet()
+    opt = torch.optim.Adam(net.parameters(), lr=lr, weight_decay=1e-5)
+    obs = torch.from_numpy(train.obs.astype(np.float32))
+    dec = torch.from_numpy(train.decision)
+    y = torch.from_numpy(train.success.astype(np.float32))
+    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=epochs)
+    gen = torch.Generator().manual_seed(seed)
+    for _ in tqdm(range(epochs), desc="fit success model", disable=not progress, unit="epoch"):
+        net.train()
+        perm = torch.randperm(len(y), generator=gen)
+        for i in range(0, len(y), batch_size):
+            b = perm[i:i + batch_size]
+            loss = F.binary_cross_entropy_with_logits(net.logit(obs[b], dec[b]), y[b])
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+        sched.step()
+    net.eval()
+    with torch.no_grad():
+        z = net.logit(torch.from_numpy(calib.obs.astype(np.float32)), torch.from_numpy(calib.decision))
+    a_b = _platt(z, torch.from_numpy(calib.success.astype(np.float32)))
+    net.platt.copy_(a_b)
+    with torch.no_grad():
+        p_cal = net(torch.from_numpy(calib.obs.astype(np.float32)), torch.from_numpy(calib.decision)).numpy()
+    return net, dict(train=len(train), calibration=len(calib), platt=a_b.tolist(),
+                     calibration_metrics=metrics(p_cal, calib.success))
+
+
+def _platt(z: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
+    """``(a, b)`` minimising the log-loss of ``sigmoid(a z + b)``."""
+    ab = torch.tensor([1.0, 0.0], requires_grad=True)
+    opt = torch.optim.LBFGS([ab], lr=0.5, max_iter=200)
+
+    def closure():
+        opt.zero_grad()
+        loss = F.binary_cross_entropy_with_logits(ab[0] * z + ab[1], y)
+        loss.backward()
+        return loss
+
+    opt.step(closure)
+    return ab.detach()
+
+
+# ------------------------------------------------------------------------ save and load
+def save(net: SuccessNet, path: str | os.PathLike, info: dict) -> None:
+    from primitives import checkpoint as ckpt
+
+    ckpt.save(Path(path), dict(model=net.state_dict(), info=info))
+
+
+def load_success_net(skill: str, path: str | os.PathLike | None = None) -> SuccessNet:
+    """A success net from ``path`` or the shipped ``weights/{skill}_success.pt``."""
+    from primitives import checkpoint as ckpt
+
+    path = Path(path) if path else WEIGHTS_DIR / f"{skill}_success.pt"
+    if not path.exists():
+        raise ckpt.CheckpointError(f"no success model at {path}")
+    try:
+        state = torch.load(path, map_location="cpu", weights_only=False)
+        net = SuccessNet()
+        net.load_state_dict(state["model"])
+    except Exception as exc:
+        raise ckpt.CheckpointError(f"success model {path} is damaged ({type(exc).__name__}: {exc})") from exc
+    return net.eval()
+
+
+def bench_query(model: SuccessModel, obs: np.ndarray, repeats: int = 200) -> float:
+    """Median seconds per single query (policy decision + success net) on one observation."""
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        model.predict(obs)
+        times.append(time.perf_counter() - t)
+    return float(np.median(times))
+
+
+# ----------------------------------------------------------------------------------- CLI
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m primitives.success", description="Train and evaluate a skill's success model.",
+        epilog="examples:\n"
+               "  python -m primitives.success train push --rollouts 6000 --out runs/push_success\n"
+               "  python -m primitives.success evaluate push --rollouts 1500 --plot reliability_push.png",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    for name in ("train", "evaluate"):
+        s = sub.add_parser(name)
+        s.add_argument("skill", choices=PRIMITIVES)
+        s.add_argument("--policy", default=None, help="policy weights (default: the shipped ones)")
+        s.add_argument("--rollouts", type=int, default=6000 if name == "train" else 1500)
+        s.add_argument("--seed", type=int, default=0 if name == "train" else 4321)
+        s.add_argument("--out", default=None, help="folder for rollouts, model, figures (default: runs/SKILL_success)")
+        s.add_argument("--json", action="store_true")
+    sub.choices["evaluate"].add_argument("--model", default=None, help="success model (default: shipped)")
+    sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
+    sub.choices["train"].add_argument("--epochs", type=int, default=40)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    from primitives.evaluate import load_policy
+
+    args = build_parser().parse_args(argv)
+    torch.set_num_threads(1)
+    out = Path(args.out or f"runs/{args.skill}_success")
+    out.mkdir(parents=True, exist_ok=True)
+    policy = load_policy(args.policy, args.skill)
+    if args.command == "train":
+        cache = out / f"train_rollouts_{args.rollouts}_{args.seed}.npz"
+        data = Rollouts.load(cache) if cache.exists() else collect(policy, args.skill, args.rollouts, "train",
+                                                                   seed=args.seed, progress=not args.json)
+        data.save(cache)
+        net, info = fit(data, seed=args.seed, epochs=args.epochs, progress=not args.json)
+        info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped")
+        save(net, out / "success.pt", info)
+        print(json.dumps(info, indent=2))
+        return 0
+    net = load_success_net(args.skill, args.model)
+    data = collect(policy, args.skill, args.rollouts, "test", n_objects=200, seed=args.seed, progress=not args.json)
+    model = SuccessModel(policy, net)
+    with torch.no_grad():
+        p = net(torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)).numpy()
+    result = dict(skill=args.skill, objects="test split (never trained on)", all=metrics(p, data.success),
+                  parameterised=metrics(p[data.parameterised], data.success[data.parameterised]),
+                  query_ms=1e3 * bench_query(model, data.obs[0].astype(np.float32)))
+    if args.plot:
+        plot_reliability(p, data.success, args.plot, f"{args.skill} success model, unseen objects")
+    print(json.dumps(result, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

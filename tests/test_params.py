@@ -1,0 +1,104 @@
+"""Skill parameters: checking, roll adjacency, goal flow, and the parameterised objectives."""
+
+import math
+
+import numpy as np
+import pytest
+
+import affordplan as ap
+from affordplan.errors import InputError
+from affordplan.geometry import make_pose, rot_z
+from primitives import params, rewards
+
+
+def _pose(xy=(0.5, 0.0), yaw=0.0, z=0.05, R=None):
+    return make_pose(rot_z(yaw) if R is None else R, (xy[0], xy[1], z))
+
+
+def test_check_normalises_and_rejects():
+    cube = ap.load_object("cube")
+    assert params.check("push", None) is None
+    assert params.check("push", {"direction": 3 * math.pi})["direction"] == pytest.approx(-math.pi)
+    assert params.check("spin", {"angle": -math.radians(30)}) == {"angle": -math.radians(30)}
+    assert params.check("roll", {"target": 1}, cube, 0) == {"target": 1}
+    bad = [("push", {"direction": float("nan")}), ("push", {"angle": 0.2}), ("push", 0.3),
+           ("spin", {"angle": math.radians(10)}), ("spin", {"angle": math.radians(50)}),
+           ("spin", {"angle": "left"}), ("roll", {"target": 1.0}), ("roll", {"target": True})]
+    for skill, p in bad:
+        with pytest.raises(InputError):
+            params.check(skill, p)
+    with pytest.raises(InputError, match="not a resting state"):
+        params.check("roll", {"target": 6}, cube, 0)
+
+
+def test_roll_targets_are_one_roll_away():
+    cube = ap.load_object("cube")
+    for s in range(6):
+        targets = params.roll_targets(cube, s)
+        assert len(targets) == 4 and s not in targets  # the four neighbouring faces, not the opposite one
+        up = cube.resting_states[s].up
+        opposite = [t for t in range(6) if t != s and t not in targets]
+        assert len(opposite) == 1 and cube.resting_states[opposite[0]].up @ up < -0.99
+    with pytest.raises(InputError, match="one roll away"):
+        params.check("roll", {"target": opposite[0]}, cube, s)
+
+
+def test_goal_flow_matches_the_asked_motion():
+    cube = ap.load_object("cube")
+    T = cube.resting_states[0].pose((0.5, 0.1), 0.3)
+    pts = np.array([[0.55, 0.1, 0.05], [0.5, 0.15, 0.1]])
+    flow = params.goal_flow("push", {"direction": math.pi / 2}, pts, T)
+    assert np.allclose(flow, [[0, 0.05, 0]] * 2, atol=1e-6)
+    flow = params.goal_flow("spin", {"angle": math.pi / 2}, pts, T)
+    assert np.allclose(flow[0], [-0.05, 0.05, 0.0], atol=1e-6)  # (0.05, 0) about the centre -> (0, 0.05)
+    assert not params.goal_flow("push", None, pts, T).any()
+    # Roll: after the asked tip, the target state's up-vector points up and the centre sits at its height.
+    for target in params.roll_targets(cube, 0):
+        Tp = params.goal_transform("roll", {"target": target}, T, cube)
+        T_after = Tp @ T
+        assert cube.classify(T_after) == target
+        assert T_after[2, 3] == pytest.approx(cube.resting_states[target].height)
+        theta = math.degrees(np.arccos((np.trace(Tp[:3, :3]) - 1) / 2))
+        assert theta == pytest.approx(90.0, abs=1.0)
+
+
+def test_parameterised_objectives_reduce_to_the_seed_and_judge_the_parameter():
+    T0 = _pose()
+    east = _pose((0.56, 0.0))
+    north = _pose((0.5, 0.06))
+    for T1 in (east, north):
+        assert rewards.loss("push", T0, T1) == rewards.push_loss(T0, T1)
+        assert rewards.success("push", T0, T1) == rewards.push_success(T0, T1)
+    assert rewards.success("push", T0, east, {"direction": 0.0})
+    assert not rewards.success("push", T0, north, {"direction": 0.0})  # moved, but the wrong way
+    assert rewards.success("push", T0, _pose((0.556, 0.014)), {"direction": 0.0})  # 14 deg off: inside 15
+    assert not rewards.success("push", T0, _pose((0.556, 0.016)), {"direction": 0.0})  # 16 deg off
+    assert rewards.loss("push", T0, east, {"direction": 0.0}) == pytest.approx(0.0)
+    assert rewards.loss("push", T0, north, {"direction": 0.0}) == pytest.approx(1.0 + 10 * 0.06)
+
+    left = _pose(yaw=math.radians(28))
+    assert rewards.success("spin", T0, left, {"angle": math.radians(35)})  # 7 deg short: inside 10
+    assert not rewards.success("spin", T0, left, {"angle": -math.radians(35)})  # wrong way
+    assert not rewards.success("spin", T0, left, {"angle": math.radians(40)})  # 12 deg short
+    assert rewards.loss("spin", T0, left, {"angle": math.radians(28)}) == pytest.approx(0.0, abs=1e-9)
+    assert rewards.loss("spin", T0, T0, {"angle": math.radians(30)}) == pytest.approx(rewards.spin_loss(T0, T0))
+
+    cube = ap.load_object("cube")
+    Ts = cube.resting_states[0].pose((0.5, 0.0), 0.0)
+    target = params.roll_targets(cube, 0)[0]
+    Tt = cube.resting_states[target].pose((0.52, 0.0), 0.4)
+    assert rewards.success("roll", Ts, Tt, {"target": target}, cube)
+    assert not rewards.success("roll", Ts, Ts, {"target": target}, cube)
+    assert rewards.loss("roll", Ts, Tt, {"target": target}, cube) == pytest.approx(0.5 * 0.02, abs=1e-6)
+    assert rewards.loss("roll", Ts, Ts, {"target": target}, cube) == pytest.approx(90 / 60, abs=1e-3)
+
+
+def test_sample_covers_the_ranges():
+    rng = np.random.default_rng(0)
+    cube = ap.load_object("cube")
+    spins = [params.sample("spin", rng, cube, 0, 1.0)["angle"] for _ in range(200)]
+    assert min(map(abs, spins)) >= params.SPIN_MIN and max(map(abs, spins)) <= params.SPIN_MAX
+    assert min(spins) < 0 < max(spins)
+    rolls = {params.sample("roll", rng, cube, 0, 1.0)["target"] for _ in range(100)}
+    assert rolls == set(params.roll_targets(cube, 0))
+    assert sum(params.sample("push", rng, cube, 0, 0.5) is None for _ in range(400)) in range(160, 240)

@@ -1,0 +1,62 @@
+"""Success models: metrics, calibration and fitting on synthetic rollouts, shipped models."""
+
+import numpy as np
+import pytest
+import torch
+
+from primitives import success
+from primitives.networks import HybridActorCritic
+
+
+def test_metrics_on_known_values():
+    y = np.array([1, 1, 0, 0], bool)
+    assert success.auroc(np.array([0.9, 0.8, 0.2, 0.1]), y) == 1.0
+    assert success.auroc(np.array([0.1, 0.2, 0.8, 0.9]), y) == 0.0
+    assert success.auroc(np.full(4, 0.5), y) == 0.5
+    assert success.brier(np.array([1.0, 0.0]), np.array([1, 1])) == 0.5
+    # Two bins: predictions 0.15 (measured 0) and 0.85 (measured 1), half the samples each.
+    assert success.ece(np.array([0.15, 0.15, 0.85, 0.85]), y[::-1]) == pytest.approx(0.15)
+
+
+def _synthetic(n: int, rng: np.random.Generator) -> success.Rollouts:
+    """Clouds whose success depends on the goal flow's x: pushes towards +x succeed 90 %, others 10 %."""
+    obs = rng.normal(0, 0.03, size=(n, 32, 9)).astype(np.float32)
+    direction = rng.uniform(-np.pi, np.pi, size=n)
+    obs[:, :, 6] = 0.05 * np.cos(direction)[:, None]
+    obs[:, :, 7] = 0.05 * np.sin(direction)[:, None]
+    obs[:, :, 8] = 0
+    p_true = np.where(np.cos(direction) > 0, 0.9, 0.1)
+    y = rng.random(n) < p_true
+    return success.Rollouts(obs.astype(np.float16), np.zeros((n, success.N_DECISION), np.float32), y,
+                            rng.integers(0, 50, size=n), np.ones(n, bool))
+
+
+def test_fit_learns_and_calibrates_on_synthetic_rollouts():
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(0)
+    net, info = success.fit(_synthetic(1500, rng), seed=0, epochs=8, progress=False)
+    test = _synthetic(1000, rng)
+    with torch.no_grad():
+        p = net(torch.from_numpy(test.obs.astype(np.float32)), torch.from_numpy(test.decision)).numpy()
+    m = success.metrics(p, test.success)
+    assert m["auroc"] > 0.8  # the best possible here is ~0.9
+    assert m["ece"] < 0.08
+    assert abs(m["mean_prediction"] - m["success_rate"]) < 0.05
+
+
+def test_model_answers_single_and_batched_queries(tmp_path):
+    torch.manual_seed(0)
+    model = success.SuccessModel(HybridActorCritic(), success.SuccessNet())
+    obs = np.random.default_rng(0).normal(0, 0.03, size=(3, 64, 9)).astype(np.float32)
+    p = model.predict(obs)
+    assert p.shape == (3,) and np.all((p > 0) & (p < 1))
+    assert model.predict(obs[1]) == pytest.approx(p[1], abs=1e-6)
+    success.save(model.net, tmp_path / "s.pt", {})
+    assert torch.equal(success.load_success_net("push", tmp_path / "s.pt").platt, model.net.platt)
+    (tmp_path / "bad.pt").write_bytes(b"not a checkpoint")
+    from primitives.checkpoint import CheckpointError
+
+    with pytest.raises(CheckpointError):
+        success.load_success_net("push", tmp_path / "bad.pt")
+    with pytest.raises(CheckpointError):
+        success.load_success_net("push", tmp_path / "missing.pt")
