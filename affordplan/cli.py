@@ -14,6 +14,7 @@ examples:
   affordplan bench sim --object mug -n 1000 --json
   affordplan bench sim --pusher arm        # the 7-DOF arm through mink IK
   affordplan bench sim2sim -n 100          # the same primitives by finger and arm: outcome gap
+  affordplan affordances lunch_box --plot lunch_box.png   # predicted vs measured success per state
 """
 
 
@@ -42,6 +43,24 @@ def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
 
     for name in args.object:
         print(bench_sim2sim(name, args.n, seed=args.seed, progress=True).report())
+    return 0
+
+
+def _cmd_affordances(args: argparse.Namespace) -> int:
+    # The command line is a facade like affordplan.plan: it reaches the learned skills lazily.
+    from affordplan.objects.model import load_object
+    from primitives.affordances import affordance_table, as_dicts, format_table, plot_table
+
+    obj = load_object(args.object)
+    rows = affordance_table(obj, trials=args.trials, sectors=args.sectors, seed=args.seed, progress=not args.json)
+    if args.json:
+        print(json.dumps(dict(object=obj.name, rows=as_dicts(rows)), indent=2))
+    else:
+        print(format_table(obj, rows))
+    if args.plot:
+        plot_table(obj, rows, args.plot)
+        if not args.json:
+            print(f"wrote {args.plot}")
     return 0
 
 
@@ -94,6 +113,23 @@ def build_parser() -> argparse.ArgumentParser:
     s2s.add_argument("-n", type=int, default=100, help="primitives per object (default: %(default)s)")
     s2s.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     s2s.set_defaults(func=_cmd_bench_sim2sim)
+
+    aff = sub.add_parser(
+        "affordances", help="predicted vs measured success of each skill in each resting state",
+        description="For every resting state of OBJECT: the success model's prediction for push (per "
+                    "direction sector, relative to the object's heading), spin (30 deg each way) and roll "
+                    "(to each state one roll away), next to the rate measured by executing in the finger sim.",
+        epilog="examples:\n  affordplan affordances lunch_box\n  affordplan affordances pill_bottle --trials 20 "
+               "--plot pill.png --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    aff.add_argument("object", help="catalogue name or mesh path")
+    aff.add_argument("--trials", type=int, default=10, help="starts per action (default: %(default)s)")
+    aff.add_argument("--sectors", type=int, default=8, help="push direction sectors (default: %(default)s)")
+    aff.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    aff.add_argument("--plot", default=None, help="write a bar chart per resting state here")
+    aff.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    aff.set_defaults(func=_cmd_affordances)
     return parser
 
 

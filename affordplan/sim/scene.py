@@ -23,6 +23,11 @@ FINGER_RADIUS = 0.008  # metres
 FINGER_LENGTH = 0.08  # metres, cylinder part of the capsule above the tip
 PARK_POSITION = (0.5, 0.0, -0.3)  # where the finger waits: under the table (it does not collide with it), out of view
 
+# Sliding friction of the table (MuJoCo takes the larger of two geoms' values, so this is the
+# object-table friction). At 0.5 a 10 cm cube pushed horizontally at its top edge slides instead of
+# tipping (tipping needs mu > half-width / height = 0.5): no roll of a cube or box is possible. At 0.8
+# (a rubber mat, wood on wood) it tips; pushes low on the object still slide.
+TABLE_FRICTION = 0.8
 OBJECT_CONTACT = 'condim="6" friction="0.5 0.005 0.002" solref="0.005 1" solimp="0.95 0.99 0.001"'
 
 
@@ -141,7 +146,7 @@ def build_mjcf(obj: ObjectModel, obstacles: tuple[Box, ...] = (), pusher: str = 
   <camera name="wide" pos="1.05 -0.7 0.55" xyaxes="{_look_at((1.05, -0.7, 0.55), (0.4, 0.0, 0.15))}"/>
   <camera name="top" pos="0.52 0 1.3" xyaxes="{_look_at((0.52, 0.0, 1.3), (0.52, 0.0, 0.0))}"/>
   <geom name="table" type="plane" size="1.5 1.5 0.05" material="table" contype="1" conaffinity="1"
-        friction="0.5 0.005 0.002"/>
+        friction="{TABLE_FRICTION} 0.005 0.002"/>
   {obstacles_xml}
   {body}
   {pusher_xml}
