@@ -19,14 +19,29 @@ if _sys.platform.startswith("linux") and not _os.environ.get("DISPLAY") and "muj
     _os.environ.setdefault("MUJOCO_GL", "egl")
 
 from affordplan import errors  # noqa: E402
+from affordplan.goal import Goal  # noqa: E402
 from affordplan.objects import ObjectModel, RestingState, catalogue, load_object, random_object  # noqa: E402
 from affordplan.sim import Outcome, Simulator  # noqa: E402
 from affordplan.world import Box, Workspace  # noqa: E402
+
+
+def plan(obj, goal, *, start=None, obstacles=(), time_limit=5.0, planner="affordplan", seed=0, **kwargs):
+    """Plan to bring ``obj`` from ``start`` to ``goal`` around ``obstacles``; returns a ``Plan``.
+
+    ``start``: ``{"resting_state": i, "xy": (x, y), "yaw": a}`` (metres, radians) or a 4x4 pose;
+    ``planner``: ``"affordplan"`` (resting-state graph + OMPL + learned skills) or ``"greedy"`` (the
+    reactive baseline). See :mod:`planner.plan`. The planner package is imported here, lazily.
+    """
+    from planner.api import plan as _plan
+
+    return _plan(obj, goal, start=start, obstacles=obstacles, time_limit=time_limit, planner=planner, seed=seed,
+                 **kwargs)
 
 __version__ = "0.1.0"
 
 __all__ = [
     "Box",
+    "Goal",
     "ObjectModel",
     "Outcome",
     "RestingState",
@@ -35,5 +50,6 @@ __all__ = [
     "catalogue",
     "errors",
     "load_object",
+    "plan",
     "random_object",
 ]

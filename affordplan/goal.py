@@ -1,0 +1,70 @@
+"""Goals for the planner: where the object should end up, in which resting state, and how closely."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from affordplan.errors import GoalError
+from affordplan.geometry import wrap_angle
+from affordplan.objects.model import ObjectModel
+
+
+@dataclass(frozen=True)
+class Goal:
+    """A target for the object on the table.
+
+    Args:
+        xy: position of the centre of mass on the table, metres, world frame.
+        yaw: heading in the goal's resting state, radians (see :mod:`affordplan.objects.resting`);
+            ``None``: any.
+        resting_state: index into ``obj.resting_states``; ``None``: any (the start's is kept).
+        xy_tol: reached when the centre is within this distance, metres.
+        yaw_tol: and the yaw within this angle, radians.
+    """
+
+    xy: tuple[float, float]
+    yaw: float | None = None
+    resting_state: int | None = None
+    xy_tol: float = 0.03
+    yaw_tol: float = math.radians(15.0)
+
+    def __post_init__(self):
+        xy = np.asarray(self.xy, dtype=float).reshape(-1)
+        if xy.shape != (2,) or not np.all(np.isfinite(xy)):
+            raise GoalError(f"goal xy must be two finite numbers (metres), got {self.xy!r}")
+        object.__setattr__(self, "xy", (float(xy[0]), float(xy[1])))
+        if self.yaw is not None:
+            if not isinstance(self.yaw, (int, float, np.floating)) or not math.isfinite(self.yaw):
+                raise GoalError(f"goal yaw must be a finite angle in radians or None, got {self.yaw!r}")
+            object.__setattr__(self, "yaw", float(self.yaw))
+        if self.resting_state is not None and (
+                not isinstance(self.resting_state, (int, np.integer)) or isinstance(self.resting_state, bool)):
+            raise GoalError(f"goal resting_state must be an integer index or None, got {self.resting_state!r}")
+        for name in ("xy_tol", "yaw_tol"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float, np.floating)) or not math.isfinite(v) or v <= 0:
+                raise GoalError(f"goal {name} must be a positive number, got {v!r}")
+
+    def check_object(self, obj: ObjectModel) -> None:
+        """Raise :class:`GoalError` when the resting state does not exist for ``obj``."""
+        n = len(obj.resting_states)
+        if self.resting_state is not None and not 0 <= self.resting_state < n:
+            raise GoalError(f"goal resting_state {self.resting_state} does not exist: {obj.name} has {n} resting "
+                            f"states (0..{n - 1})")
+
+    def errors(self, obj: ObjectModel, T_world_object: np.ndarray) -> tuple[float, float, bool]:
+        """``(xy distance in metres, |yaw error| in radians (0 without a goal yaw), state matches)``."""
+        state = obj.classify(T_world_object)
+        d = float(np.hypot(T_world_object[0, 3] - self.xy[0], T_world_object[1, 3] - self.xy[1]))
+        yaw_err = 0.0
+        if self.yaw is not None:
+            yaw = obj.resting_states[state].yaw_of(T_world_object[:3, :3])
+            yaw_err = abs(wrap_angle(yaw - self.yaw))
+        return d, yaw_err, self.resting_state is None or state == self.resting_state
+
+    def reached(self, obj: ObjectModel, T_world_object: np.ndarray) -> bool:
+        d, yaw_err, state_ok = self.errors(obj, T_world_object)
+        return state_ok and d <= self.xy_tol and yaw_err <= self.yaw_tol

@@ -1,0 +1,206 @@
+"""Closed-loop execution of plans, and the greedy baseline.
+
+:func:`execute_plan` runs a :class:`planner.plan.Plan` in a simulator: observe the object's pose; if
+the goal is reached, stop; if the pose is off the plan (more than ``XY_TOL`` / ``YAW_TOL`` from where
+the next step expects it, or in another resting state), replan from the observed pose; execute the
+next step's skill with its parameter; remember failures, so that a (state, skill, parameter) that
+failed twice is avoided by the next plan. It stops on success, on ``max_primitives``, or when no plan
+can be found.
+
+:func:`execute_greedy` is the reactive baseline a user would otherwise reach for (HACMan-style):
+at every step, among pushes in 8 directions, spins of 30 deg either way and rolls to each state one
+roll away, take the call whose predicted outcome (success model times ideal effect) gets closest to
+the goal; no resting-state graph, no obstacle-aware path.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from affordplan.errors import AffordplanError, PlanningError
+from affordplan.geometry import wrap_angle
+from affordplan.goal import Goal
+from affordplan.objects.model import ObjectModel
+from affordplan.sim.simulator import Simulator
+from planner.predict import expected_pose, pose_xy_yaw
+from primitives import params as skill_params
+
+XY_TOL = 0.025  # metres off the plan before replanning
+YAW_TOL = math.radians(12.0)
+
+
+@dataclass
+class LogEntry:
+    """One primitive of an execution."""
+
+    index: int
+    skill: str
+    params: dict
+    success: bool
+    valid: bool
+    pose_before: np.ndarray = field(repr=False)
+    pose_after: np.ndarray = field(repr=False)
+    replanned: bool = False
+    p_success: float = float("nan")
+    note: str = ""
+
+    def __str__(self) -> str:
+        (k, v), = self.params.items()
+        value = f"{math.degrees(v):+.0f} deg" if k in ("direction", "angle") else f"state {v}"
+        x0, y0, x1, y1 = self.pose_before[0, 3], self.pose_before[1, 3], self.pose_after[0, 3], self.pose_after[1, 3]
+        return (f"{self.index:2d}. {self.skill:4s} {k}={value:10s} ({x0:.3f}, {y0:.3f}) -> ({x1:.3f}, {y1:.3f}) "
+                f"{'ok ' if self.success else 'FAIL'}{' (replanned)' if self.replanned else ''}"
+                f"{' ' + self.note if self.note else ''}")
+
+
+@dataclass
+class Execution:
+    """What running a plan did.
+
+    Attributes:
+        success: the goal was reached (position, yaw, resting state within the goal's tolerances).
+        final_pose: the object's last 4x4 world pose.
+        n_primitives: skill calls executed.
+        replans: plans made after the first (the object went off plan or a step failed).
+        log: one entry per primitive.
+        reason: why it stopped.
+        frames: rendered frames, when asked for.
+    """
+
+    success: bool
+    final_pose: np.ndarray
+    n_primitives: int
+    replans: int
+    log: list[LogEntry]
+    reason: str = ""
+    planning_time: float = 0.0
+    frames: list[np.ndarray] = field(default_factory=list, repr=False)
+
+    def __str__(self) -> str:
+        head = (f"execution: {'SUCCESS' if self.success else 'FAILED'} after {self.n_primitives} primitives, "
+                f"{self.replans} replans ({self.reason})")
+        return "\n".join([head] + [f"  {e}" for e in self.log])
+
+
+def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int) -> Simulator:
+    if isinstance(sim, Simulator):
+        return sim
+    if sim not in ("arm", "finger"):
+        raise AffordplanError(f"sim must be 'arm', 'finger' or a Simulator, got {sim!r}")
+    s = Simulator(obj, obstacles=obstacles, pusher=sim, seed=seed)
+    s.set_object_pose(T_start)
+    return s
+
+
+def _off_plan(obj: ObjectModel, T: np.ndarray, T_expected: np.ndarray) -> bool:
+    s, x, y, yaw = pose_xy_yaw(obj, T)
+    se, xe, ye, yawe = pose_xy_yaw(obj, T_expected)
+    return s != se or math.hypot(x - xe, y - ye) > XY_TOL or abs(wrap_angle(yaw - yawe)) > YAW_TOL
+
+
+def _frame(sim: Simulator, render) -> np.ndarray | None:
+    if not render:
+        return None
+    camera = render if isinstance(render, str) else "overview"
+    return sim.render(camera=camera)
+
+
+def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
+    """Run ``plan`` closed-loop (see the module docstring)."""
+    planner, goal = plan.planner, plan.goal
+    obj = planner.obj
+    sim = _simulator(sim, obj, planner.obstacles, plan.start_pose, seed)
+    steps, k = list(plan.steps), 0
+    log: list[LogEntry] = []
+    frames = [f for f in [_frame(sim, render)] if f is not None]
+    replans, planning_time, reason = 0, plan.planning_time, "max_primitives reached"
+    for n in range(max_primitives + 1):
+        T = sim.object_pose()
+        if goal.reached(obj, T):
+            reason = "goal reached"
+            break
+        if n == max_primitives:
+            break
+        replanned = False
+        if k >= len(steps) or _off_plan(obj, T, steps[k].start_pose):
+            try:
+                new = planner.plan(T, goal)
+            except (PlanningError, AffordplanError) as exc:
+                reason = f"no plan from the observed pose: {exc}"
+                break
+            steps, k, replanned = list(new.steps), 0, True
+            replans += 1
+            planning_time += new.planning_time
+            if not steps:
+                reason = "planner has nothing left to do but the goal is not reached"
+                break
+        step = steps[k]
+        skill = planner.predictor.skills[step.skill]
+        try:
+            out = skill.execute(sim, step.params)
+        except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
+            planner.record_failure(step.skill, step.params, T)
+            log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc)))
+            k = len(steps)
+            continue
+        if not out.success:
+            planner.record_failure(step.skill, step.params, T)
+        log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
+                            out.pose_after, replanned, step.p_success))
+        f = _frame(sim, render)
+        if f is not None:
+            frames.append(f)
+        k += 1
+    T = sim.object_pose()
+    return Execution(goal.reached(obj, T), T, len(log), replans, log, reason, planning_time, frames)
+
+
+# ------------------------------------------------------------------------------- greedy
+def _goal_distance(obj: ObjectModel, goal: Goal, T: np.ndarray) -> float:
+    d, yaw_err, state_ok = goal.errors(obj, T)
+    return d / goal.xy_tol + yaw_err / goal.yaw_tol + (0.0 if state_ok else 3.0)
+
+
+def greedy_calls(obj: ObjectModel, state: int) -> list[tuple[str, dict]]:
+    calls = [("push", {"direction": a}) for a in np.linspace(-math.pi, math.pi, 8, endpoint=False)]
+    calls += [("spin", {"angle": math.radians(30.0)}), ("spin", {"angle": -math.radians(30.0)})]
+    calls += [("roll", {"target": t}) for t in skill_params.roll_targets(obj, state)]
+    return calls
+
+
+def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor, sim="arm", obstacles=(),
+                   max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
+    """The greedy baseline (see the module docstring)."""
+    sim = _simulator(sim, obj, obstacles, T_start, seed)
+    log: list[LogEntry] = []
+    frames = [f for f in [_frame(sim, render)] if f is not None]
+    reason, planning_time = "max_primitives reached", 0.0
+    for n in range(max_primitives + 1):
+        T = sim.object_pose()
+        if goal.reached(obj, T):
+            reason = "goal reached"
+            break
+        if n == max_primitives:
+            break
+        t0 = time.perf_counter()
+        state = obj.classify(T)
+        calls = greedy_calls(obj, state)
+        p = predictor.p_success_many([(s, prm, T) for s, prm in calls])
+        now = _goal_distance(obj, goal, T)
+        scores = [pi * _goal_distance(obj, goal, expected_pose(obj, s, prm, T)) + (1 - pi) * now
+                  for (s, prm), pi in zip(calls, p)]
+        best = int(np.argmin(scores))
+        planning_time += time.perf_counter() - t0
+        skill_name, prm = calls[best]
+        out = predictor.skills[skill_name].execute(sim, prm)
+        log.append(LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
+                            False, float(p[best])))
+        f = _frame(sim, render)
+        if f is not None:
+            frames.append(f)
+    T = sim.object_pose()
+    return Execution(goal.reached(obj, T), T, len(log), 0, log, reason, planning_time, frames)

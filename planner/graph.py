@@ -1,0 +1,64 @@
+"""The resting-state graph: which face changes to make, and in what order.
+
+Nodes are the object's resting states; a directed edge ``i -> j`` is a roll from state ``i`` to a
+state ``j`` one roll away (:func:`primitives.params.roll_targets`), weighted by ``-log P(success)``
+of the roll skill. The cheapest route is then the likeliest chain of rolls (success probabilities
+multiply along a route). A failed roll can be down-weighted (:meth:`RestingStateGraph.penalise`),
+so the next route goes another way.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import networkx as nx
+
+from affordplan.errors import PlanningError
+from affordplan.objects.model import ObjectModel
+from primitives.params import roll_targets
+
+MIN_PROBABILITY = 1e-4  # floor on edge probabilities, so that -log stays finite
+
+
+class RestingStateGraph:
+    """Directed graph over resting states with roll edges weighted by ``-log P(success)``.
+
+    Args:
+        obj: the object.
+        roll_probability: ``(i, j) -> P(a roll from state i ends in state j)``.
+    """
+
+    def __init__(self, obj: ObjectModel, roll_probability: Callable[[int, int], float]):
+        self.obj = obj
+        self.graph = nx.DiGraph()
+        for s in obj.resting_states:
+            self.graph.add_node(s.index, probability=s.probability)
+        for s in obj.resting_states:
+            for t in roll_targets(obj, s.index):
+                p = min(1.0, max(MIN_PROBABILITY, float(roll_probability(s.index, t))))
+                self.graph.add_edge(s.index, t, p=p, weight=-math.log(p))
+
+    def probability(self, i: int, j: int) -> float:
+        return float(self.graph.edges[i, j]["p"])
+
+    def penalise(self, i: int, j: int, factor: float = 0.25) -> None:
+        """Multiply the success probability of roll ``i -> j`` by ``factor`` (after repeated failures)."""
+        if self.graph.has_edge(i, j):
+            e = self.graph.edges[i, j]
+            e["p"] = max(MIN_PROBABILITY, e["p"] * factor)
+            e["weight"] = -math.log(e["p"])
+
+    def route(self, start: int, goal: int) -> list[int]:
+        """States visited from ``start`` to ``goal`` (both included) on the likeliest chain of rolls."""
+        if start == goal:
+            return [start]
+        try:
+            return [int(s) for s in nx.shortest_path(self.graph, start, goal, weight="weight")]
+        except nx.NetworkXNoPath:
+            raise PlanningError(
+                f"{self.obj.name}: no chain of rolls leads from resting state {start} to {goal}") from None
+
+    def route_probability(self, route: list[int]) -> float:
+        """Product of the rolls' success probabilities along ``route``."""
+        return math.prod(self.probability(a, b) for a, b in zip(route, route[1:]))

@@ -1,0 +1,286 @@
+"""Long-horizon plans: face changes on the resting-state graph, SE(2) paths around obstacles, skill calls.
+
+:class:`Planner` builds a :class:`Plan` from a start pose to a :class:`affordplan.goal.Goal`:
+
+1. **Route.** The likeliest chain of rolls from the start's resting state to the goal's
+   (:class:`planner.graph.RestingStateGraph`, edges ``-log P(roll)`` from the roll skill's success model).
+2. **Roll spots.** Each roll happens where it has room: the nearest place (to the object, then to the
+   goal) where a disc covering the object before and after the roll, grown by ``roll_margin`` (the
+   displacement a roll causes), is clear of obstacles.
+3. **Paths.** Between rolls, and from the last one to the goal, OMPL plans the footprint's SE(2) path
+   (:mod:`planner.motion`); the footprint of each resting state is inflated by ``clearance`` (the room
+   the fingertip needs beside the object).
+4. **Calls.** Paths become pushes and spins (:mod:`planner.chain`); each step carries its expected
+   pose and its predicted success (:class:`planner.predict.Predictor`); ``Plan.p_success`` is their product.
+
+Failures reported back (:meth:`Planner.record_failure`) down-weight what failed: a roll edge in the
+graph, or a push direction (relative to the object) / spin sense in a resting state, which the next
+plan then avoids (a push is split into two pushes 35 deg to either side).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from affordplan.errors import GoalError, PlanningError
+from affordplan.geometry import wrap_angle
+from affordplan.goal import Goal
+from affordplan.objects.model import ObjectModel
+from affordplan.world import Box, Workspace
+from planner import chain
+from planner.footprint import footprint, inflate
+from planner.graph import RestingStateGraph
+from planner.motion import FootprintChecker, plan_path
+from planner.predict import Predictor, expected_pose, pose_xy_yaw, state_pose
+
+FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is avoided
+SPLIT_ANGLE = math.radians(35.0)
+WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
+
+
+@dataclass
+class Step:
+    """One skill call of a plan.
+
+    Attributes:
+        skill: ``"push"``, ``"spin"`` or ``"roll"``.
+        params: its parameter (see :mod:`primitives.params`).
+        start_pose, expected_pose: 4x4 world poses before and (ideally) after.
+        p_success: the skill's predicted success at ``start_pose``.
+    """
+
+    skill: str
+    params: dict
+    start_pose: np.ndarray = field(repr=False)
+    expected_pose: np.ndarray = field(repr=False)
+    p_success: float = float("nan")
+
+    def __str__(self) -> str:
+        (k, v), = self.params.items()
+        value = f"{math.degrees(v):+.0f} deg" if k in ("direction", "angle") else f"state {v}"
+        x, y = self.expected_pose[0, 3], self.expected_pose[1, 3]
+        return f"{self.skill:4s} {k}={value:10s} -> ({x:.3f}, {y:.3f})  P={self.p_success:.2f}"
+
+
+def failure_key(obj: ObjectModel, skill: str, params: dict, T_world_object: np.ndarray) -> tuple:
+    """What a failure is remembered by: (state, skill, parameter bucket relative to the object)."""
+    state, _, _, yaw = pose_xy_yaw(obj, T_world_object)
+    if skill == "push":
+        return state, skill, int(round(wrap_angle(params["direction"] - yaw) / (math.pi / 4))) % 8
+    if skill == "spin":
+        return state, skill, int(math.copysign(1, params["angle"]))
+    return state, skill, params["target"]
+
+
+class Planner:
+    """Plans for one object among fixed obstacles.
+
+    Args:
+        obj: the object.
+        obstacles: boxes on the table.
+        workspace: where the object may go.
+        predictor: skills and success models (the shipped ones by default).
+        time_limit: seconds for one :meth:`plan` call (OMPL gets what is left).
+        seed: seeds OMPL and the predictor.
+        clearance: metres the footprint is grown by (room for the fingertip beside the object).
+        roll_margin: metres around a roll spot kept clear for the displacement a roll causes.
+    """
+
+    def __init__(self, obj: ObjectModel, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
+                 predictor: Predictor | None = None, time_limit: float = 5.0, seed: int = 0,
+                 clearance: float = 0.02, roll_margin: float = 0.04):
+        self.obj = obj
+        self.obstacles = tuple(obstacles)
+        self.workspace = workspace
+        self.predictor = predictor or Predictor(obj, seed=seed)
+        self.time_limit = float(time_limit)
+        self.seed = int(seed)
+        self.clearance = clearance
+        self.roll_margin = roll_margin
+        self.failures: Counter = Counter()
+        states = obj.resting_states
+        self.footprints = {s.index: inflate(footprint(obj, s.index), clearance) for s in states}
+        # The object's centre must stay in the workspace; its (inflated) footprint may overhang it a little.
+        m = WORKSPACE_OVERHANG
+        grown = Workspace((workspace.x[0] - m, workspace.x[1] + m), (workspace.y[0] - m, workspace.y[1] + m))
+        self.checkers = {i: FootprintChecker(fp, self.obstacles, grown) for i, fp in self.footprints.items()}
+        self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
+        self.graph = RestingStateGraph(obj, self._roll_probability)
+        self._calls = 0
+
+    # ------------------------------------------------------------------ queries
+    def _roll_probability(self, i: int, j: int) -> float:
+        x, y = self.workspace.center
+        return self.predictor.p_success("roll", {"target": j}, state_pose(self.obj, i, x, y, 0.0))
+
+    def record_failure(self, skill: str, params: dict, T_world_object: np.ndarray) -> int:
+        """Remember a failed call; returns how often that (state, skill, parameter) has failed."""
+        key = failure_key(self.obj, skill, params, T_world_object)
+        self.failures[key] += 1
+        if skill == "roll" and self.failures[key] >= FAILURES_TO_AVOID:
+            self.graph.penalise(key[0], params["target"])
+        return self.failures[key]
+
+    def _avoided(self, skill: str, params: dict, T: np.ndarray) -> bool:
+        return self.failures[failure_key(self.obj, skill, params, T)] >= FAILURES_TO_AVOID
+
+    def check_goal(self, goal: Goal, start_state: int) -> int:
+        """The goal's resting state; raises :class:`GoalError` for goals that cannot be met."""
+        goal.check_object(self.obj)
+        state = start_state if goal.resting_state is None else goal.resting_state
+        if not self.workspace.contains(goal.xy):
+            raise GoalError(f"goal xy={goal.xy} is outside the workspace {self.workspace}")
+        checker = self.checkers[state]
+        yaws = [goal.yaw] if goal.yaw is not None else list(np.linspace(-math.pi, math.pi, 12, endpoint=False))
+        if not any(checker.is_free(*goal.xy, a) for a in yaws):
+            why = checker.why_not_free(*goal.xy, yaws[0])
+            raise GoalError(f"goal xy={goal.xy} is not reachable by the object in resting state {state}: {why}")
+        return state
+
+    # --------------------------------------------------------------------- plan
+    def plan(self, T_start: np.ndarray, goal: Goal) -> Plan:
+        """A plan from the settled pose ``T_start`` to ``goal``; raises PlanningError / GoalError."""
+        t0 = time.perf_counter()
+        deadline = t0 + self.time_limit
+        state, x, y, yaw = pose_xy_yaw(self.obj, T_start)
+        goal_state = self.check_goal(goal, state)
+        route = self.graph.route(state, goal_state)
+        calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
+        paths: list[tuple[int, np.ndarray]] = []
+        cur = (x, y, yaw)
+        if not self.checkers[state].is_free(*cur):  # pushed into a tight spot: push it out first
+            free = self._nearest_free(state, cur)
+            calls.append((state, "push", {"direction": math.atan2(free[1] - y, free[0] - x)}, (*free, yaw)))
+            cur = (*free, yaw)
+        for a, b in zip(route, route[1:]):
+            spot = self._roll_spot(a, b, cur, goal)
+            spot_yaw = self._free_yaw(a, spot, cur[2])
+            path = self._path(a, cur, (*spot, spot_yaw), deadline)
+            paths.append((a, path))
+            calls += [(a, *c) for c in chain.path_to_calls(path)]
+            cur = (*spot, spot_yaw) if not calls else calls[-1][3]
+            T_before = state_pose(self.obj, a, *cur)
+            T_after = expected_pose(self.obj, "roll", {"target": b}, T_before)
+            _, ax, ay, ayaw = pose_xy_yaw(self.obj, T_after)
+            calls.append((a, "roll", {"target": b}, (ax, ay, ayaw)))
+            cur = (ax, ay, ayaw)
+        goal_yaw = goal.yaw if goal.yaw is not None else self._free_yaw(goal_state, goal.xy, cur[2])
+        path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
+        paths.append((goal_state, path))
+        calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if goal.yaw is not None else None)]
+        steps = self._steps(T_start, state, calls)
+        p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
+        self._calls += 1
+        return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
+                    goal=goal, start_pose=np.array(T_start), planner=self)
+
+    def _steps(self, T_start: np.ndarray, state: int, calls) -> list[Step]:
+        steps: list[Step] = []
+        T = state_pose(self.obj, state, *pose_xy_yaw(self.obj, T_start)[1:])
+        for call_state, skill, params, after in calls:
+            if skill == "push" and self._avoided(skill, params, T):  # go round the failing direction
+                for side in (SPLIT_ANGLE, -SPLIT_ANGLE):
+                    p = {"direction": wrap_angle(params["direction"] + side)}
+                    T_next = expected_pose(self.obj, "push", p, T)
+                    steps.append(Step("push", p, T, T_next))
+                    T = T_next
+                continue
+            new_state = params["target"] if skill == "roll" else call_state
+            T_next = state_pose(self.obj, new_state, *after)
+            steps.append(Step(skill, params, T, T_next))
+            T = T_next
+        if steps:
+            ps = self.predictor.p_success_many([(s.skill, s.params, s.start_pose) for s in steps])
+            for s, p in zip(steps, ps):
+                s.p_success = float(p)
+        return steps
+
+    def _path(self, state: int, start, goal, deadline: float) -> np.ndarray:
+        left = deadline - time.perf_counter()
+        if left <= 0:
+            raise PlanningError(f"planning ran out of its {self.time_limit:.1f} s before reaching the goal")
+        return plan_path(self.checkers[state], tuple(start), tuple(goal), time_limit=min(left, 1.0),
+                         seed=self.seed + self._calls, attempts=2)
+
+    def _free_yaw(self, state: int, xy, prefer: float) -> float:
+        checker = self.checkers[state]
+        for d in np.radians([0, 15, -15, 30, -30, 45, -45, 60, -60, 90, -90, 120, -120, 150, -150, 180]):
+            if checker.is_free(xy[0], xy[1], prefer + d):
+                return float(wrap_angle(prefer + d))
+        raise PlanningError(f"no free orientation of resting state {state} at {tuple(np.round(xy, 3))}")
+
+    def _nearest_free(self, state: int, cur) -> tuple[float, float]:
+        """The nearest position (5 mm grid) where the footprint is free at the current yaw."""
+        for r in np.arange(0.005, 0.3, 0.005):
+            for a in np.linspace(-math.pi, math.pi, max(8, int(2 * math.pi * r / 0.005)), endpoint=False):
+                px, py = cur[0] + r * math.cos(a), cur[1] + r * math.sin(a)
+                if self.checkers[state].is_free(px, py, cur[2]):
+                    return float(px), float(py)
+        raise PlanningError(f"the object is stuck at {tuple(np.round(cur[:2], 3))}: no free position nearby")
+
+    def _roll_spot(self, a: int, b: int, cur, goal: Goal) -> tuple[float, float]:
+        """Nearest place where a roll from state ``a`` to ``b`` has room."""
+        r = max(self.radius[a], self.radius[b]) + self.roll_margin
+        disc = r * np.stack([np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
+                             np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False))], axis=1)
+        checker = FootprintChecker(disc, self.obstacles, self.workspace)
+        if checker.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur):
+            return float(cur[0]), float(cur[1])
+        ws = self.workspace
+        xs = np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01)
+        ys = np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01)
+        best, best_cost = None, math.inf
+        for px in xs:
+            for py in ys:
+                cost = math.hypot(px - cur[0], py - cur[1]) + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1])
+                if cost < best_cost and checker.is_free(px, py, 0.0):
+                    best, best_cost = (float(px), float(py)), cost
+        if best is None:
+            raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
+        return best
+
+
+@dataclass
+class Plan:
+    """A plan: skill calls with expected poses and predicted success.
+
+    Attributes:
+        steps: the calls, in order.
+        p_success: product of the steps' predicted success.
+        planning_time: seconds.
+        route: resting states visited.
+        paths: ``(resting state, (m, 3) SE(2) path)`` per segment.
+    """
+
+    steps: list[Step]
+    p_success: float
+    planning_time: float
+    route: list[int] = field(default_factory=list)
+    paths: list[tuple[int, np.ndarray]] = field(default_factory=list, repr=False)
+    goal: Goal | None = None
+    start_pose: np.ndarray | None = field(default=None, repr=False)
+    planner: Planner | None = field(default=None, repr=False)
+    kind: str = "affordplan"  # or "greedy": no steps, every call chosen on the spot
+
+    def __str__(self) -> str:
+        if self.kind == "greedy":
+            return "plan: greedy (each call chosen on the spot when executed)"
+        head = (f"plan: {len(self.steps)} steps, route {self.route}, P(success) {self.p_success:.3f}, "
+                f"planned in {1e3 * self.planning_time:.0f} ms")
+        return "\n".join([head] + [f"  {i:2d}. {s}" for i, s in enumerate(self.steps)])
+
+    def execute(self, sim="arm", max_primitives: int = 60, render=None, seed: int = 0):
+        """Run the plan closed-loop (see :mod:`planner.execute`); returns an ``Execution``."""
+        from planner.execute import execute_greedy, execute_plan
+
+        if self.kind == "greedy":
+            p = self.planner
+            return execute_greedy(p.obj, self.goal, self.start_pose, p.predictor, sim=sim, obstacles=p.obstacles,
+                                  max_primitives=max_primitives, render=render, seed=seed)
+        return execute_plan(self, sim=sim, max_primitives=max_primitives, render=render, seed=seed)

@@ -1,0 +1,171 @@
+"""The planner: graph routes, paths through gaps, chaining, closed-loop replanning, bad goals.
+
+Skills are replaced by stand-ins with known behaviour (they move the object to the pose the call
+asks for, or fail on purpose), so that these tests check the planner, not the learned policies.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import affordplan as ap
+from affordplan.errors import GoalError, PlanningError
+from affordplan.sim.simulator import Outcome
+from planner import chain
+from planner.execute import execute_plan
+from planner.footprint import footprint, place
+from planner.graph import RestingStateGraph
+from planner.plan import Planner
+from planner.predict import expected_pose, pose_xy_yaw
+from primitives import params as skill_params
+
+WALL_WITH_GAP = (ap.Box(center=(0.6, -0.2), size=(0.02, 0.2, 0.1)), ap.Box(center=(0.6, 0.2), size=(0.02, 0.2, 0.1)))
+
+
+class IdealSkill:
+    """Does exactly what it is asked (teleports the object), except calls listed in ``fail``."""
+
+    def __init__(self, name: str, fail=lambda params, state: False):
+        self.name, self.fail, self.calls = name, fail, []
+
+    def execute(self, sim, params):
+        T0 = sim.object_pose()
+        state = sim.obj.classify(T0)
+        self.calls.append((state, dict(params)))
+        ok = not self.fail(params, state)
+        T1 = expected_pose(sim.obj, self.name, params, T0) if ok else T0
+        sim.set_object_pose(T1, settle=False)
+        return Outcome(T0, T1, 0, True, True, 0.0, success=ok)
+
+
+class StubPredictor:
+    def __init__(self, skills, p=0.8):
+        self.skills, self.p, self.queries = skills, p, 0
+
+    def p_success(self, skill, params, T):
+        return self.p
+
+    def p_success_many(self, queries):
+        return np.full(len(queries), self.p)
+
+
+def _planner(obj, obstacles=(), fail_roll=None):
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    if fail_roll:
+        skills["roll"] = IdealSkill("roll", fail=lambda params, state: (state, params["target"]) == fail_roll)
+    return Planner(obj, obstacles, predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+
+
+def test_graph_prefers_the_likelier_route():
+    cube = ap.load_object("cube")
+    direct, via = 1, 2
+    assert direct in skill_params.roll_targets(cube, 0) and via in skill_params.roll_targets(cube, 0)
+    probs = {(0, direct): 0.2, (0, via): 0.9, (via, direct): 0.9}
+    graph = RestingStateGraph(cube, lambda i, j: probs.get((i, j), 0.05))
+    assert graph.route(0, direct) == [0, via, direct]  # 0.81 beats 0.2
+    assert graph.route_probability([0, via, direct]) == pytest.approx(0.81)
+    graph.penalise(0, via, factor=0.1)
+    assert graph.route(0, direct) == [0, direct]  # 0.2 now beats 0.081
+    opposite = next(s for s in range(6) if s != 0 and s not in skill_params.roll_targets(cube, 0))
+    assert len(graph.route(0, opposite)) == 3  # the opposite face takes two rolls
+
+
+def test_path_through_the_gap_is_collision_free():
+    cube = ap.load_object("cube")
+    planner = _planner(cube, WALL_WITH_GAP)
+    goal = ap.Goal(xy=(0.69, 0.0), yaw=0.0)
+    plan = planner.plan(cube.resting_states[0].pose((0.42, 0.15), 0.4), goal)
+    (state, path), = plan.paths
+    fp = footprint(cube, state)
+    import fcl
+
+    walls = []
+    for box in WALL_WITH_GAP:
+        o = fcl.CollisionObject(fcl.Box(*box.size), fcl.Transform(np.array([*box.center, 0.05])))
+        walls.append(o)
+    crossed = False
+    for x, y, yaw in path:
+        poly = place(fp, x, y, yaw)
+        verts = np.vstack([np.c_[poly, np.zeros(len(poly))], np.c_[poly, np.full(len(poly), 0.1)]])
+        n = len(poly)
+        tris = [[0, i, i + 1] for i in range(1, n - 1)] + [[n, n + i + 1, n + i] for i in range(1, n - 1)]
+        tris += [[i, (i + 1) % n, n + i] for i in range(n)] + [[(i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+        mesh = fcl.BVHModel()
+        mesh.beginModel(len(verts), len(tris))
+        mesh.addSubModel(verts, np.array(tris))
+        mesh.endModel()
+        body = fcl.CollisionObject(mesh, fcl.Transform())
+        for w in walls:
+            assert fcl.collide(body, w, fcl.CollisionRequest(), fcl.CollisionResult()) == 0
+        if abs(x - 0.6) < 0.01:
+            crossed = True
+            assert abs(y) < 0.1  # through the gap
+    assert crossed
+    steps = plan.steps
+    assert all(s.skill in ("push", "spin") for s in steps)
+    assert all(skill_params.SPIN_MIN - 1e-9 <= abs(s.params["angle"]) <= skill_params.SPIN_MAX + 1e-9
+               for s in steps if s.skill == "spin")
+    assert goal.reached(cube, steps[-1].expected_pose)
+
+
+def test_chained_calls_track_the_path():
+    path = np.array([[0.4, 0.0, 0.0], [0.5, 0.0, math.radians(60)], [0.5, 0.1, math.radians(60)]])
+    from planner.motion import interpolate_path
+
+    calls = chain.path_to_calls(interpolate_path(path), goal_yaw=math.radians(-30))
+    x, y, yaw = 0.4, 0.0, 0.0
+    for skill, params, after in calls:
+        if skill == "push":
+            assert math.hypot(after[0] - x, after[1] - y) <= skill_params.PUSH_STEP + 0.011
+            assert after[2] == yaw
+        else:
+            assert (after[0], after[1]) == (x, y)
+            assert math.radians(15) - 1e-9 <= abs(params["angle"]) <= math.radians(45) + 1e-9
+        x, y, yaw = after
+    assert math.hypot(x - 0.5, y - 0.1) < 0.01 and abs(yaw - math.radians(-30)) <= chain.YAW_DEADBAND
+
+
+def test_forced_failure_replans_without_repeating_the_failed_step():
+    cube = ap.load_object("cube")
+    direct = skill_params.roll_targets(cube, 0)[0]
+    planner = _planner(cube, fail_roll=(0, direct))
+    goal = ap.Goal(xy=(0.55, 0.05), resting_state=direct)
+    plan = planner.plan(cube.resting_states[0].pose((0.5, 0.0), 0.0), goal)
+    assert plan.route == [0, direct]
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=20)
+    assert ex.success, str(ex)
+    rolls = planner.predictor.skills["roll"].calls
+    failed = [c for c in rolls if c == (0, {"target": direct})]
+    assert len(failed) == 2  # tried twice, then avoided
+    assert ex.replans >= 1
+    assert len(rolls) >= 4  # two more rolls: round another face
+    assert cube.classify(ex.final_pose) == direct
+
+
+def test_bad_goals_raise_their_errors():
+    cube = ap.load_object("cube")
+    planner = _planner(cube, WALL_WITH_GAP)
+    T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
+    with pytest.raises(GoalError, match="obstacle"):
+        planner.plan(T0, ap.Goal(xy=(0.6, 0.2)))  # inside the wall
+    with pytest.raises(GoalError, match="workspace"):
+        planner.plan(T0, ap.Goal(xy=(0.95, 0.0)))
+    with pytest.raises(GoalError, match="does not exist"):
+        planner.plan(T0, ap.Goal(xy=(0.5, 0.0), resting_state=9))
+    with pytest.raises(GoalError):
+        ap.Goal(xy=(float("nan"), 0.0))
+    with pytest.raises(GoalError):
+        ap.Goal(xy=(0.5, 0.0), yaw=float("inf"))
+    closed = WALL_WITH_GAP + (ap.Box(center=(0.6, 0.0), size=(0.02, 0.25, 0.1)),)
+    with pytest.raises(PlanningError):
+        _planner(cube, closed).plan(T0, ap.Goal(xy=(0.69, 0.0)))
+
+
+def test_pose_helpers_round_trip():
+    cube = ap.load_object("cube")
+    T = cube.resting_states[3].pose((0.52, -0.04), 1.1)
+    state, x, y, yaw = pose_xy_yaw(cube, T)
+    assert (state, round(x, 6), round(y, 6)) == (3, 0.52, -0.04) and yaw == pytest.approx(1.1)
