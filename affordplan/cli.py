@@ -14,6 +14,7 @@ examples:
   affordplan bench sim --object mug -n 1000 --json
   affordplan bench sim --pusher arm        # the 7-DOF arm through mink IK
   affordplan bench sim2sim -n 100          # the same primitives by finger and arm: outcome gap
+  affordplan bench plan --tasks 50 --sim arm   # plan-and-execute success, affordplan vs greedy
   affordplan affordances lunch_box --plot lunch_box.png   # predicted vs measured success per state
 """
 
@@ -43,6 +44,15 @@ def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
 
     for name in args.object:
         print(bench_sim2sim(name, args.n, seed=args.seed, progress=True).report())
+    return 0
+
+
+def _cmd_bench_plan(args: argparse.Namespace) -> int:
+    from planner.bench import bench_plan
+
+    report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
+                        max_primitives=args.max_primitives, progress=not args.json)
+    print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
 
@@ -113,6 +123,21 @@ def build_parser() -> argparse.ArgumentParser:
     s2s.add_argument("-n", type=int, default=100, help="primitives per object (default: %(default)s)")
     s2s.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     s2s.set_defaults(func=_cmd_bench_sim2sim)
+
+    bp = bench_sub.add_parser(
+        "plan", help="plan-and-execute success on random tasks, affordplan vs greedy",
+        description="Random tasks (walls with gaps, blocks, face changes, goal yaw) on objects never trained "
+                    "on; prints success, median planning time, primitives and replans per task for each planner.",
+        epilog="example:\n  affordplan bench plan --tasks 50 --sim arm --seed 0",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    bp.add_argument("--tasks", type=int, default=50, help="number of tasks (default: %(default)s)")
+    bp.add_argument("--sim", default="arm", choices=["arm", "finger"], help="pusher (default: arm)")
+    bp.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    bp.add_argument("--planner", nargs="+", default=["affordplan", "greedy"], choices=["affordplan", "greedy"])
+    bp.add_argument("--max-primitives", type=int, default=40, help="per task (default: %(default)s)")
+    bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bp.set_defaults(func=_cmd_bench_plan)
 
     aff = sub.add_parser(
         "affordances", help="predicted vs measured success of each skill in each resting state",

@@ -1,0 +1,155 @@
+"""``affordplan bench plan``: random plan-and-execute tasks, affordplan against the greedy baseline.
+
+Each task draws an object from the procedural *test* split (never trained on), a scene (a wall with
+a gap between start and goal, two or three blocks, or an open table), a start (resting state by its
+probability, position on the near side, random yaw) and a goal (the far side; a different resting
+state in 40 % of tasks; a goal yaw in half of them). Both planners run the same task in the same
+simulator kind; success is the goal reached within 3 cm, 15 deg (when a yaw is asked) and in the
+right resting state, within ``max_primitives``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from affordplan.errors import AffordplanError
+from affordplan.goal import Goal
+from affordplan.objects.model import ObjectModel, random_object
+from affordplan.world import Box, Workspace
+from planner.plan import Planner
+from planner.predict import Predictor
+
+
+@dataclass
+class Task:
+    object_index: int
+    scene: str
+    obstacles: tuple[Box, ...]
+    start: dict
+    goal: Goal
+
+
+@dataclass
+class TaskResult:
+    planner: str
+    scene: str
+    success: bool
+    planning_time: float  # first plan, seconds
+    primitives: int
+    replans: int
+    reason: str = ""
+
+
+@dataclass
+class BenchReport:
+    results: list[TaskResult] = field(default_factory=list)
+
+    def summary(self, planner: str) -> dict:
+        rs = [r for r in self.results if r.planner == planner]
+        if not rs:
+            return {}
+        return dict(planner=planner, tasks=len(rs), success=float(np.mean([r.success for r in rs])),
+                    median_planning_time_s=float(np.median([r.planning_time for r in rs])),
+                    mean_primitives=float(np.mean([r.primitives for r in rs])),
+                    mean_replans=float(np.mean([r.replans for r in rs])),
+                    success_by_scene={s: float(np.mean([r.success for r in rs if r.scene == s]))
+                                      for s in sorted({r.scene for r in rs})})
+
+    def report(self) -> str:
+        lines = [f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median)':>19s} "
+                 f"{'primitives/task':>16s} {'replans/task':>13s}  by scene"]
+        for name in dict.fromkeys(r.planner for r in self.results):
+            s = self.summary(name)
+            scenes = ", ".join(f"{k} {v:.2f}" for k, v in s["success_by_scene"].items())
+            lines.append(f"{name:10s} {s['tasks']:5d} {s['success']:8.2f} {1e3 * s['median_planning_time_s']:16.0f} ms "
+                         f"{s['mean_primitives']:16.1f} {s['mean_replans']:13.1f}  {scenes}")
+        return "\n".join(lines)
+
+    def as_dict(self) -> dict:
+        names = list(dict.fromkeys(r.planner for r in self.results))
+        return dict(summary=[self.summary(n) for n in names], tasks=[asdict(r) for r in self.results])
+
+
+def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...]:
+    if kind == "wall_gap":
+        x = rng.uniform(0.56, 0.6)
+        gap = 2 * radius + 0.06
+        c = rng.uniform(-0.08, 0.08)
+        lo, hi = c - gap / 2, c + gap / 2
+        return (Box(center=(x, (lo - 0.32) / 2), size=(0.02, lo + 0.32, 0.1)),
+                Box(center=(x, (hi + 0.32) / 2), size=(0.02, 0.32 - hi, 0.1)))
+    if kind == "blocks":
+        n = int(rng.integers(2, 4))
+        return tuple(Box(center=(rng.uniform(0.5, 0.62), rng.uniform(-0.2, 0.2)), size=(0.06, 0.06, 0.08),
+                         yaw=rng.uniform(0, math.pi)) for _ in range(n))
+    return ()
+
+
+def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Workspace()) -> tuple[Task, ObjectModel]:
+    """A random task whose start and goal are free (resampled until they are)."""
+    obj = random_object(index, "test")
+    states = obj.resting_states
+    probs = np.array([s.probability for s in states])
+    radius = max(float(np.linalg.norm(obj.mesh.extents[:2])) / 2, 0.03)
+    kind = str(rng.choice(["wall_gap", "blocks", "open"], p=[0.5, 0.3, 0.2]))
+    for _ in range(200):
+        obstacles = _scene(rng, kind, radius)
+        s0 = int(rng.choice(len(states), p=probs / probs.sum()))
+        start = dict(resting_state=s0, xy=(float(rng.uniform(0.38, 0.46)), float(rng.uniform(-0.15, 0.15))),
+                     yaw=float(rng.uniform(-math.pi, math.pi)))
+        goal_state = s0
+        if len(states) > 1 and rng.random() < 0.4:
+            goal_state = int(rng.choice([s.index for s in states if s.index != s0]))
+        goal = Goal(xy=(float(rng.uniform(0.64, 0.7)), float(rng.uniform(-0.12, 0.12))),
+                    yaw=float(rng.uniform(-math.pi, math.pi)) if rng.random() < 0.5 else None,
+                    resting_state=goal_state)
+        checker = Planner(obj, obstacles, workspace, predictor=_NoPredictor()).checkers
+        if checker[s0].is_free(*start["xy"], start["yaw"]) and \
+                any(checker[goal_state].is_free(*goal.xy, a) for a in np.linspace(-3.1, 3.1, 12)):
+            return Task(index, kind, obstacles, start, goal), obj
+    raise AffordplanError(f"could not place a free start and goal for task {index}")
+
+
+class _NoPredictor:
+    """Stands in for the skills where only footprints and checkers are needed."""
+
+    skills: dict = {}
+
+    def p_success(self, skill, params, T):
+        return 0.5
+
+    def p_success_many(self, queries):
+        return np.full(len(queries), 0.5)
+
+
+def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
+             max_primitives: int, time_limit: float) -> TaskResult:
+    from planner.api import plan as make_plan
+
+    t0 = time.perf_counter()
+    try:
+        p = make_plan(obj, task.goal, start=task.start, obstacles=task.obstacles, time_limit=time_limit,
+                      planner=planner_name, seed=seed, predictor=predictor)
+    except AffordplanError as exc:
+        return TaskResult(planner_name, task.scene, False, time.perf_counter() - t0, 0, 0, f"no plan: {exc}")
+    ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed)
+    first = p.planning_time if planner_name == "affordplan" else ex.planning_time / max(1, ex.n_primitives)
+    return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason)
+
+
+def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
+               max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True) -> BenchReport:
+    """Run ``n_tasks`` random tasks with each planner (see the module docstring)."""
+    rng = np.random.default_rng(seed)
+    report = BenchReport()
+    for i in tqdm(range(n_tasks), desc=f"bench plan ({sim})", disable=not progress, unit="task"):
+        task, obj = make_task(rng, i)
+        predictor = Predictor(obj, seed=seed)
+        for name in planners:
+            report.results.append(run_task(task, obj, name, sim, predictor, seed + i, max_primitives, time_limit))
+    return report

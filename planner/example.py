@@ -1,0 +1,34 @@
+"""Shared by the planning examples in examples/: plan, print, execute in the arm sim, save a plot and frames."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import affordplan as ap
+from planner.plot import plot_plan, save_frames
+
+
+def run_example(name: str, obj, goal, start, obstacles, description: str) -> int:
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--sim", default="arm", choices=["arm", "finger"])
+    parser.add_argument("--out", default=f"affordplan-examples/{name}")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--max-primitives", type=int, default=60)
+    parser.add_argument("--no-render", action="store_true")
+    args = parser.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    plan = ap.plan(obj, goal, start=start, obstacles=obstacles, seed=args.seed)
+    print(plan)
+    ex = plan.execute(sim=args.sim, max_primitives=args.max_primitives, seed=args.seed,
+                      render=None if args.no_render else "overview")
+    print(ex)
+    d, yaw_err, state_ok = goal.errors(obj, ex.final_pose)
+    print(f"final: {100 * d:.1f} cm from the goal, yaw error {math.degrees(yaw_err):.0f} deg, "
+          f"resting state {'right' if state_ok else 'wrong'}")
+    plot_plan(plan, out / "plan.png", execution=ex)
+    save_frames(ex.frames, out / "frames.png")
+    print(f"wrote {out / 'plan.png'} and {out / 'frames.png'}")
+    return 0 if ex.success else 1
