@@ -169,3 +169,28 @@ def test_pose_helpers_round_trip():
     T = cube.resting_states[3].pose((0.52, -0.04), 1.1)
     state, x, y, yaw = pose_xy_yaw(cube, T)
     assert (state, round(x, 6), round(y, 6)) == (3, 0.52, -0.04) and yaw == pytest.approx(1.1)
+
+
+def test_greedy_baseline_reaches_an_open_goal_with_ideal_skills():
+    from planner.execute import execute_greedy
+
+    cube = ap.load_object("cube")
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    goal = ap.Goal(xy=(0.62, 0.05))
+    sim = ap.Simulator(cube, seed=0)
+    T0 = sim.reset(0, (0.45, 0.0), 0.0)
+    ex = execute_greedy(cube, goal, T0, StubPredictor(skills), sim=sim, max_primitives=15)
+    assert ex.success, str(ex)
+    assert {e.skill for e in ex.log} == {"push"}
+
+
+def test_bench_tasks_have_free_starts_and_goals():
+    from planner.bench import make_task
+
+    rng = np.random.default_rng(0)
+    for i in range(3):
+        task, obj = make_task(rng, i)
+        checkers = _planner(obj, task.obstacles).checkers
+        s = task.start["resting_state"]
+        assert checkers[s].is_free(*task.start["xy"], task.start["yaw"])
+        assert task.goal.resting_state is not None and 0 <= task.goal.resting_state < len(obj.resting_states)
