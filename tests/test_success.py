@@ -60,3 +60,14 @@ def test_model_answers_single_and_batched_queries(tmp_path):
         success.load_success_net("push", tmp_path / "bad.pt")
     with pytest.raises(CheckpointError):
         success.load_success_net("push", tmp_path / "missing.pt")
+
+
+def test_shipped_success_models_load_and_answer():
+    import affordplan as ap
+    from primitives import load_skill
+
+    sim = ap.Simulator(ap.load_object("cube"), seed=0)
+    sim.reset(0, (0.5, 0.0), 0.0)
+    for name, params in (("push", {"direction": 0.0}), ("spin", {"angle": 0.5}), ("roll", {"target": 1})):
+        p = load_skill(name).success_probability(sim, params)
+        assert 0.0 < p < 1.0
