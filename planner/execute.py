@@ -109,6 +109,12 @@ def _frame(sim: Simulator, render) -> np.ndarray | None:
     return sim.render(camera=camera)
 
 
+def _record_frame(sim: Simulator, render, frames: list[np.ndarray]) -> None:
+    f = _frame(sim, render)
+    if f is not None:
+        frames.append(f)
+
+
 def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
     """Run ``plan`` closed-loop (see the module docstring)."""
     planner, goal = plan.planner, plan.goal
@@ -151,9 +157,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
             planner.record_failure(step.skill, step.params, T)
         log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
                             out.pose_after, replanned, step.p_success))
-        f = _frame(sim, render)
-        if f is not None:
-            frames.append(f)
+        _record_frame(sim, render, frames)
         k += 1
     T = sim.object_pose()
     return Execution(goal.reached(obj, T), T, len(log), replans, log, reason, planning_time, frames)
@@ -199,8 +203,6 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
         out = predictor.skills[skill_name].execute(sim, prm)
         log.append(LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
                             False, float(p[best])))
-        f = _frame(sim, render)
-        if f is not None:
-            frames.append(f)
+        _record_frame(sim, render, frames)
     T = sim.object_pose()
     return Execution(goal.reached(obj, T), T, len(log), 0, log, reason, planning_time, frames)
