@@ -57,12 +57,9 @@ class Goal:
 
     def errors(self, obj: ObjectModel, T_world_object: np.ndarray) -> tuple[float, float, bool]:
         """``(xy distance in metres, |yaw error| in radians (0 without a goal yaw), state matches)``."""
-        state = obj.classify(T_world_object)
-        d = float(np.hypot(T_world_object[0, 3] - self.xy[0], T_world_object[1, 3] - self.xy[1]))
-        yaw_err = 0.0
-        if self.yaw is not None:
-            yaw = obj.resting_states[state].yaw_of(T_world_object[:3, :3])
-            yaw_err = abs(wrap_angle(yaw - self.yaw))
+        state, x, y, yaw = obj.planar_pose(T_world_object)
+        d = float(np.hypot(x - self.xy[0], y - self.xy[1]))
+        yaw_err = 0.0 if self.yaw is None else abs(wrap_angle(yaw - self.yaw))
         return d, yaw_err, self.resting_state is None or state == self.resting_state
 
     def reached(self, obj: ObjectModel, T_world_object: np.ndarray) -> bool:

@@ -60,9 +60,8 @@ def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] =
         p.check_goal(goal, obj.classify(T0))
         return Plan(steps=[], p_success=float("nan"), planning_time=0.0, route=[], goal=goal, start_pose=T0,
                     planner=p, kind="greedy")
-    state, x, y, yaw = obj.classify(T0), T0[0, 3], T0[1, 3], 0.0
-    if not p.checkers[state].is_free(x, y, obj.resting_states[state].yaw_of(T0[:3, :3])):
-        raise InputError(f"the start pose collides or leaves the workspace: "
-                         f"{p.checkers[state].why_not_free(x, y, obj.resting_states[state].yaw_of(T0[:3, :3]))}")
-    del yaw
+    state, x, y, yaw = obj.planar_pose(T0)
+    why = p.checkers[state].why_not_free(x, y, yaw)
+    if why is not None:
+        raise InputError(f"the start pose collides or leaves the workspace: {why}")
     return p.plan(T0, goal)

@@ -26,7 +26,7 @@ from affordplan.geometry import wrap_angle
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
-from planner.predict import expected_pose, pose_xy_yaw
+from planner.predict import expected_pose
 from primitives import params as skill_params
 
 XY_TOL = 0.025  # metres off the plan before replanning
@@ -97,8 +97,8 @@ def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int)
 
 
 def _off_plan(obj: ObjectModel, T: np.ndarray, T_expected: np.ndarray) -> bool:
-    s, x, y, yaw = pose_xy_yaw(obj, T)
-    se, xe, ye, yawe = pose_xy_yaw(obj, T_expected)
+    s, x, y, yaw = obj.planar_pose(T)
+    se, xe, ye, yawe = obj.planar_pose(T_expected)
     return s != se or math.hypot(x - xe, y - ye) > XY_TOL or abs(wrap_angle(yaw - yawe)) > YAW_TOL
 
 

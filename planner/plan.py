@@ -37,7 +37,7 @@ from planner import chain
 from planner.footprint import footprint, inflate
 from planner.graph import RestingStateGraph
 from planner.motion import FootprintChecker, plan_path
-from planner.predict import Predictor, expected_pose, pose_xy_yaw, state_pose
+from planner.predict import Predictor, expected_pose, state_pose
 
 FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is avoided
 SPLIT_ANGLE = math.radians(35.0)
@@ -70,7 +70,7 @@ class Step:
 
 def failure_key(obj: ObjectModel, skill: str, params: dict, T_world_object: np.ndarray) -> tuple:
     """What a failure is remembered by: (state, skill, parameter bucket relative to the object)."""
-    state, _, _, yaw = pose_xy_yaw(obj, T_world_object)
+    state, _, _, yaw = obj.planar_pose(T_world_object)
     if skill == "push":
         return state, skill, int(round(wrap_angle(params["direction"] - yaw) / (math.pi / 4))) % 8
     if skill == "spin":
@@ -148,7 +148,7 @@ class Planner:
         """A plan from the settled pose ``T_start`` to ``goal``; raises PlanningError / GoalError."""
         t0 = time.perf_counter()
         deadline = t0 + self.time_limit
-        state, x, y, yaw = pose_xy_yaw(self.obj, T_start)
+        state, x, y, yaw = self.obj.planar_pose(T_start)
         goal_state = self.check_goal(goal, state)
         route = self.graph.route(state, goal_state)
         calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
@@ -167,7 +167,7 @@ class Planner:
             cur = (*spot, spot_yaw) if not calls else calls[-1][3]
             T_before = state_pose(self.obj, a, *cur)
             T_after = expected_pose(self.obj, "roll", {"target": b}, T_before)
-            _, ax, ay, ayaw = pose_xy_yaw(self.obj, T_after)
+            _, ax, ay, ayaw = self.obj.planar_pose(T_after)
             calls.append((a, "roll", {"target": b}, (ax, ay, ayaw)))
             cur = (ax, ay, ayaw)
         goal_yaw = goal.yaw if goal.yaw is not None else self._free_yaw(goal_state, goal.xy, cur[2])
@@ -182,7 +182,7 @@ class Planner:
 
     def _steps(self, T_start: np.ndarray, state: int, calls) -> list[Step]:
         steps: list[Step] = []
-        T = state_pose(self.obj, state, *pose_xy_yaw(self.obj, T_start)[1:])
+        T = state_pose(self.obj, state, *self.obj.planar_pose(T_start)[1:])
         for call_state, skill, params, after in calls:
             if skill == "push" and self._avoided(skill, params, T):  # go round the failing direction
                 for side in (SPLIT_ANGLE, -SPLIT_ANGLE):

@@ -7,7 +7,6 @@ import os
 import numpy as np
 
 from planner.footprint import footprint, place
-from planner.predict import pose_xy_yaw
 
 
 def plot_plan(plan, path: str | os.PathLike, execution=None, title: str | None = None) -> None:
@@ -42,15 +41,15 @@ def plot_plan(plan, path: str | os.PathLike, execution=None, title: str | None =
             ax.plot([x0], [y0], marker="o" if s.skill == "spin" else "s", color=c, markersize=6)
     for skill, c in colours.items():
         ax.plot([], [], color=c, marker={"push": ">", "spin": "o", "roll": "s"}[skill], linestyle="", label=skill)
-    start_state, *_ = pose_xy_yaw(obj, plan.start_pose)
-    ax.add_patch(Polygon(place(footprint(obj, start_state), *pose_xy_yaw(obj, plan.start_pose)[1:]), fill=False,
+    start_state, *start_xy_yaw = obj.planar_pose(plan.start_pose)
+    ax.add_patch(Polygon(place(footprint(obj, start_state), *start_xy_yaw), fill=False,
                          edgecolor="black", linewidth=1.5, label="start"))
     ax.add_patch(plt.Circle(goal.xy, goal.xy_tol, color="#2ca02c", alpha=0.3, label="goal (3 cm)"))
     if execution is not None:
         xy = np.array([[e.pose_before[0, 3], e.pose_before[1, 3]] for e in execution.log]
                       + [[execution.final_pose[0, 3], execution.final_pose[1, 3]]])
         ax.plot(xy[:, 0], xy[:, 1], color="black", linestyle=":", marker=".", label="executed")
-        fstate, fx, fy, fyaw = pose_xy_yaw(obj, execution.final_pose)
+        fstate, fx, fy, fyaw = obj.planar_pose(execution.final_pose)
         ax.add_patch(Polygon(place(footprint(obj, fstate), fx, fy, fyaw), fill=False, edgecolor="#2ca02c",
                              linewidth=1.5, label="final"))
     ax.set_xlim(ws.x[0] - 0.05, ws.x[1] + 0.05)

@@ -38,13 +38,6 @@ def expected_pose(obj: ObjectModel, skill: str, params: dict, T_world_object: np
     return T
 
 
-def pose_xy_yaw(obj: ObjectModel, T_world_object: np.ndarray) -> tuple[int, float, float, float]:
-    """``(resting state, x, y, yaw)`` of a settled pose."""
-    state = obj.classify(T_world_object)
-    yaw = obj.resting_states[state].yaw_of(T_world_object[:3, :3])
-    return state, float(T_world_object[0, 3]), float(T_world_object[1, 3]), float(yaw)
-
-
 def state_pose(obj: ObjectModel, state: int, x: float, y: float, yaw: float) -> np.ndarray:
     return obj.resting_states[state].pose((x, y), yaw)
 

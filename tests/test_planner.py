@@ -17,7 +17,7 @@ from planner.execute import execute_plan
 from planner.footprint import footprint, place
 from planner.graph import RestingStateGraph
 from planner.plan import Planner
-from planner.predict import expected_pose, pose_xy_yaw
+from planner.predict import expected_pose
 from primitives import params as skill_params
 
 WALL_WITH_GAP = (ap.Box(center=(0.6, -0.2), size=(0.02, 0.2, 0.1)), ap.Box(center=(0.6, 0.2), size=(0.02, 0.2, 0.1)))
@@ -167,7 +167,7 @@ def test_bad_goals_raise_their_errors():
 def test_pose_helpers_round_trip():
     cube = ap.load_object("cube")
     T = cube.resting_states[3].pose((0.52, -0.04), 1.1)
-    state, x, y, yaw = pose_xy_yaw(cube, T)
+    state, x, y, yaw = cube.planar_pose(T)
     assert (state, round(x, 6), round(y, 6)) == (3, 0.52, -0.04) and yaw == pytest.approx(1.1)
 
 

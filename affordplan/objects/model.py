@@ -73,6 +73,12 @@ class ObjectModel:
         """Resting state of a settled 4x4 world pose, up to yaw."""
         return classify(self.resting_states, np.asarray(pose)[:3, :3])
 
+    def planar_pose(self, pose: np.ndarray) -> tuple[int, float, float, float]:
+        """``(resting state, x, y, yaw)`` of a settled 4x4 world pose (metres, radians)."""
+        state = self.classify(pose)
+        yaw = self.resting_states[state].yaw_of(np.asarray(pose)[:3, :3])
+        return state, float(pose[0, 3]), float(pose[1, 3]), float(yaw)
+
     def tilt_from_state(self, pose: np.ndarray, state: int) -> float:
         """Angle (radians) between a pose's up-vector and the nearest one of ``state``."""
         return angle_to_state(self.resting_states[state], np.asarray(pose)[:3, :3])
