@@ -21,7 +21,7 @@ from affordplan.errors import AffordplanError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel, random_object
 from affordplan.world import Box, Workspace
-from planner.plan import Planner
+from planner.plan import CLEARANCE, inflated_footprints, make_checkers
 from planner.predict import Predictor
 
 
@@ -97,6 +97,7 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
     probs = np.array([s.probability for s in states])
     radius = max(float(np.linalg.norm(obj.mesh.extents[:2])) / 2, 0.03)
     kind = str(rng.choice(["wall_gap", "blocks", "open"], p=[0.5, 0.3, 0.2]))
+    footprints = inflated_footprints(obj, CLEARANCE)
     for _ in range(200):
         obstacles = _scene(rng, kind, radius)
         s0 = int(rng.choice(len(states), p=probs / probs.sum()))
@@ -108,23 +109,11 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
         goal = Goal(xy=(float(rng.uniform(0.64, 0.7)), float(rng.uniform(-0.12, 0.12))),
                     yaw=float(rng.uniform(-math.pi, math.pi)) if rng.random() < 0.5 else None,
                     resting_state=goal_state)
-        checker = Planner(obj, obstacles, workspace, predictor=_NoPredictor()).checkers
+        checker = make_checkers(footprints, obstacles, workspace)
         if checker[s0].is_free(*start["xy"], start["yaw"]) and \
                 any(checker[goal_state].is_free(*goal.xy, a) for a in np.linspace(-3.1, 3.1, 12)):
             return Task(index, kind, obstacles, start, goal), obj
     raise AffordplanError(f"could not place a free start and goal for task {index}")
-
-
-class _NoPredictor:
-    """Stands in for the skills where only footprints and checkers are needed."""
-
-    skills: dict = {}
-
-    def p_success(self, skill, params, T):
-        return 0.5
-
-    def p_success_many(self, queries):
-        return np.full(len(queries), 0.5)
 
 
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,

@@ -41,6 +41,7 @@ from planner.predict import Predictor, expected_pose, state_pose
 
 FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is avoided
 SPLIT_ANGLE = math.radians(35.0)
+CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 
 
@@ -78,6 +79,20 @@ def failure_key(obj: ObjectModel, skill: str, params: dict, T_world_object: np.n
     return state, skill, params["target"]
 
 
+def inflated_footprints(obj: ObjectModel, clearance: float) -> dict[int, np.ndarray]:
+    """Each resting state's footprint grown by ``clearance`` metres (room for the fingertip)."""
+    return {s.index: inflate(footprint(obj, s.index), clearance) for s in obj.resting_states}
+
+
+def make_checkers(footprints: dict[int, np.ndarray], obstacles: Sequence[Box],
+                  workspace: Workspace) -> dict[int, FootprintChecker]:
+    """One checker per resting state. The object's centre must stay in the workspace; its (inflated)
+    footprint may overhang it by ``WORKSPACE_OVERHANG``."""
+    m = WORKSPACE_OVERHANG
+    grown = Workspace((workspace.x[0] - m, workspace.x[1] + m), (workspace.y[0] - m, workspace.y[1] + m))
+    return {i: FootprintChecker(fp, obstacles, grown) for i, fp in footprints.items()}
+
+
 class Planner:
     """Plans for one object among fixed obstacles.
 
@@ -94,7 +109,7 @@ class Planner:
 
     def __init__(self, obj: ObjectModel, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
                  predictor: Predictor | None = None, time_limit: float = 5.0, seed: int = 0,
-                 clearance: float = 0.02, roll_margin: float = 0.04):
+                 clearance: float = CLEARANCE, roll_margin: float = 0.04):
         self.obj = obj
         self.obstacles = tuple(obstacles)
         self.workspace = workspace
@@ -104,12 +119,8 @@ class Planner:
         self.clearance = clearance
         self.roll_margin = roll_margin
         self.failures: Counter = Counter()
-        states = obj.resting_states
-        self.footprints = {s.index: inflate(footprint(obj, s.index), clearance) for s in states}
-        # The object's centre must stay in the workspace; its (inflated) footprint may overhang it a little.
-        m = WORKSPACE_OVERHANG
-        grown = Workspace((workspace.x[0] - m, workspace.x[1] + m), (workspace.y[0] - m, workspace.y[1] + m))
-        self.checkers = {i: FootprintChecker(fp, self.obstacles, grown) for i, fp in self.footprints.items()}
+        self.footprints = inflated_footprints(obj, clearance)
+        self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
         self.graph = RestingStateGraph(obj, self._roll_probability)
         self._calls = 0
@@ -163,8 +174,10 @@ class Planner:
             spot_yaw = self._free_yaw(a, spot, cur[2])
             path = self._path(a, cur, (*spot, spot_yaw), deadline)
             paths.append((a, path))
-            calls += [(a, *c) for c in chain.path_to_calls(path)]
-            cur = (*spot, spot_yaw) if not calls else calls[-1][3]
+            segment = chain.path_to_calls(path)
+            calls += [(a, *c) for c in segment]
+            if segment:
+                cur = segment[-1][2]
             T_before = state_pose(self.obj, a, *cur)
             T_after = expected_pose(self.obj, "roll", {"target": b}, T_before)
             _, ax, ay, ayaw = self.obj.planar_pose(T_after)
@@ -174,15 +187,15 @@ class Planner:
         path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
         paths.append((goal_state, path))
         calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if goal.yaw is not None else None)]
-        steps = self._steps(T_start, state, calls)
+        steps = self._steps(state, (x, y, yaw), calls)
         p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
         self._calls += 1
         return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
                     goal=goal, start_pose=np.array(T_start), planner=self)
 
-    def _steps(self, T_start: np.ndarray, state: int, calls) -> list[Step]:
+    def _steps(self, state: int, start: tuple[float, float, float], calls) -> list[Step]:
         steps: list[Step] = []
-        T = state_pose(self.obj, state, *self.obj.planar_pose(T_start)[1:])
+        T = state_pose(self.obj, state, *start)
         for call_state, skill, params, after in calls:
             if skill == "push" and self._avoided(skill, params, T):  # go round the failing direction
                 for side in (SPLIT_ANGLE, -SPLIT_ANGLE):
