@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from affordplan.errors import AffordplanError, PlanningError
+from affordplan.errors import AffordplanError
 from affordplan.geometry import wrap_angle
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
@@ -122,7 +122,8 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
     sim = _simulator(sim, obj, planner.obstacles, plan.start_pose, seed)
     steps, k = list(plan.steps), 0
     log: list[LogEntry] = []
-    frames = [f for f in [_frame(sim, render)] if f is not None]
+    frames: list[np.ndarray] = []
+    _record_frame(sim, render, frames)
     replans, planning_time, reason = 0, plan.planning_time, "max_primitives reached"
     for n in range(max_primitives + 1):
         T = sim.object_pose()
@@ -135,7 +136,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         if k >= len(steps) or _off_plan(obj, T, steps[k].start_pose):
             try:
                 new = planner.plan(T, goal)
-            except (PlanningError, AffordplanError) as exc:
+            except AffordplanError as exc:  # PlanningError, GoalError, ...
                 reason = f"no plan from the observed pose: {exc}"
                 break
             steps, k, replanned = list(new.steps), 0, True
@@ -181,7 +182,8 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
     """The greedy baseline (see the module docstring)."""
     sim = _simulator(sim, obj, obstacles, T_start, seed)
     log: list[LogEntry] = []
-    frames = [f for f in [_frame(sim, render)] if f is not None]
+    frames: list[np.ndarray] = []
+    _record_frame(sim, render, frames)
     reason, planning_time = "max_primitives reached", 0.0
     for n in range(max_primitives + 1):
         T = sim.object_pose()
