@@ -247,8 +247,7 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
         z = net.logit(torch.from_numpy(calib.obs.astype(np.float32)), torch.from_numpy(calib.decision))
     a_b = _platt(z, torch.from_numpy(calib.success.astype(np.float32)))
     net.platt.copy_(a_b)
-    with torch.no_grad():
-        p_cal = net(torch.from_numpy(calib.obs.astype(np.float32)), torch.from_numpy(calib.decision)).numpy()
+    p_cal = torch.sigmoid(a_b[0] * z + a_b[1]).numpy()  # what net(...) now returns on the calibration set
     return net, dict(train=len(train), calibration=len(calib), platt=a_b.tolist(),
                      calibration_metrics=metrics(p_cal, calib.success))
 
