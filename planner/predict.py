@@ -16,7 +16,7 @@ from affordplan.geometry import transform_points
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import TABLE_CONTACT_HEIGHT
 from primitives import params as skill_params
-from primitives.env import observation
+from primitives.env import observe_cloud
 from primitives.skills import Skill, load_skill
 
 N_POINTS = 256
@@ -65,8 +65,7 @@ class Predictor:
         visible = np.flatnonzero(points[:, 2] > TABLE_CONTACT_HEIGHT)
         rng = np.random.default_rng(self._seed)
         idx = rng.choice(visible, size=N_POINTS, replace=len(visible) < N_POINTS)
-        flow = skill_params.goal_flow(skill, params, points[idx], T_world_object, self.obj)
-        return observation(points[idx], normals[idx], flow)
+        return observe_cloud(self.obj, skill, params, points[idx], normals[idx], T_world_object).obs
 
     def p_success(self, skill: str, params: dict | None, T_world_object: np.ndarray) -> float:
         """Predicted P(success) of ``skill`` with ``params`` at a settled pose."""

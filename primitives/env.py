@@ -12,8 +12,10 @@ applies; otherwise the seed's.
 Observation, per point (``(n_points, 9)`` float32): ``(x - cx, y - cy, z, nx, ny, nz, fx, fy, fz)``:
 position relative to the cloud's centroid on the table plane (the policy is translation invariant in
 the plane; height above the table matters), the outward normal, and the goal flow ``T_param p - p``
-the parameter asks for (zero for the seed's objective). World frame, metres; yaw is randomised at
-reset, so the policy must learn rotation on its own.
+the parameter asks for (zero for the seed's objective), all expressed in the parameter's goal frame
+(:func:`primitives.params.goal_frame`: the asked push direction is +x, the asked spin is
+counter-clockwise, the roll tips towards -x; the world frame for the seed's objective). Metres. The
+policy's motion is in the same frame; :meth:`SkillObservation.motion_to_world` maps it back.
 """
 
 from __future__ import annotations
@@ -51,6 +53,21 @@ class EnvConfig:
     p_params: float = 0.0  # probability that an episode asks for a parameter (0: the seed's objective)
 
 
+@dataclass(frozen=True)
+class SkillObservation:
+    """What a skill sees before acting: the world cloud, the policy's input and the goal frame."""
+
+    points: np.ndarray  # (n, 3) world frame, metres
+    normals: np.ndarray  # (n, 3) world frame, outward unit normals
+    obs: np.ndarray  # (n, OBS_DIM) float32, the policy's input (goal frame)
+    params: dict | None  # checked parameters
+    A_frame_world: np.ndarray  # (3, 3) world vectors -> goal frame
+
+    def motion_to_world(self, motion: np.ndarray) -> np.ndarray:
+        """A goal-frame motion in [-1, 1]^3 as a world-frame one."""
+        return self.A_frame_world.T @ np.asarray(motion, dtype=float)
+
+
 @dataclass
 class StepResult:
     reward: float
@@ -60,28 +77,40 @@ class StepResult:
     params: dict | None = None
 
 
-def observation(points: np.ndarray, normals: np.ndarray, flow: np.ndarray | None = None) -> np.ndarray:
-    """Per-point features of a world-frame cloud and its goal flow (see the module docstring)."""
+def observation(points: np.ndarray, normals: np.ndarray, flow: np.ndarray | None = None,
+                A_frame_world: np.ndarray | None = None) -> np.ndarray:
+    """Per-point features of a world-frame cloud and its goal flow (see the module docstring).
+
+    ``A_frame_world`` (3x3, keeps the vertical; identity by default) maps world vectors into the goal frame.
+    """
     obs = np.zeros((len(points), OBS_DIM), dtype=np.float32)
-    centre = points[:, :2].mean(axis=0)
-    obs[:, :2] = points[:, :2] - centre
-    obs[:, 2] = points[:, 2]
-    obs[:, 3:6] = normals
+    rel = np.array(points, dtype=float)
+    rel[:, :2] -= rel[:, :2].mean(axis=0)
+    A = np.eye(3) if A_frame_world is None else np.asarray(A_frame_world)
+    obs[:, :3] = rel @ A.T
+    obs[:, 3:6] = normals @ A.T
     if flow is not None:
-        obs[:, 6:9] = flow
+        obs[:, 6:9] = flow @ A.T
     return obs
 
 
+def observe_cloud(obj: ObjectModel, skill: str, params: dict | None, points: np.ndarray, normals: np.ndarray,
+                  T_world_object: np.ndarray) -> SkillObservation:
+    """The :class:`SkillObservation` of a world cloud of ``obj`` at ``T_world_object`` (params already checked)."""
+    flow = skill_params.goal_flow(skill, params, points, T_world_object, obj)
+    A = skill_params.goal_frame(skill, params, T_world_object, obj)
+    return SkillObservation(points, normals, observation(points, normals, flow, A), params, A)
+
+
 def skill_observation(sim: Simulator, skill: str, params: dict | None, n_points: int,
-                      state: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
-    """Cloud, normals, observation and checked params of a skill about to act in ``sim``."""
+                      state: int | None = None) -> SkillObservation:
+    """What a skill about to act in ``sim`` sees (raises :class:`InputError` for bad params)."""
     pose = sim.object_pose()
     if state is None:
         state = sim.obj.classify(pose)
     params = skill_params.check(skill, params, sim.obj, state)
     points, normals = sim.point_cloud(n_points)
-    flow = skill_params.goal_flow(skill, params, points, pose, sim.obj)
-    return points, normals, observation(points, normals, flow), params
+    return observe_cloud(sim.obj, skill, params, points, normals, pose)
 
 
 class PrimitiveEnv:
@@ -95,10 +124,8 @@ class PrimitiveEnv:
         self._seed = seed
         self._sims: OrderedDict[object, Simulator] = OrderedDict()
         self.sim: Simulator | None = None
-        self.points = np.zeros((0, 3))
-        self.normals = np.zeros((0, 3))
+        self.seen: SkillObservation | None = None
         self.object_key: object = None
-        self.params: dict | None = None
         self._episodes_left = 0
 
     # ------------------------------------------------------------------ objects
@@ -153,14 +180,24 @@ class PrimitiveEnv:
         state = sim.obj.classify(sim.object_pose())
         if isinstance(params, str) and params == "random":
             params = skill_params.sample(self.config.primitive, self.rng, sim.obj, state, self.config.p_params)
-        self.points, self.normals, obs, self.params = skill_observation(
-            sim, self.config.primitive, params, self.config.n_points, state)
-        return obs
+        self.seen = skill_observation(sim, self.config.primitive, params, self.config.n_points, state)
+        return self.seen.obs
+
+    @property
+    def points(self) -> np.ndarray:
+        """The current episode's world-frame cloud."""
+        return self.seen.points
+
+    @property
+    def params(self) -> dict | None:
+        """The current episode's parameter (``None``: the seed's objective)."""
+        return self.seen.params
 
     def step(self, index: int, motion: np.ndarray) -> StepResult:
-        """Execute the primitive at point ``index`` with ``motion``; the episode ends here."""
-        assert self.sim is not None, "call reset() first"
-        out = self.sim.execute(self.points[index], motion, normal=self.normals[index])
+        """Execute the primitive at point ``index`` with goal-frame ``motion``; the episode ends here."""
+        assert self.sim is not None and self.seen is not None, "call reset() first"
+        seen = self.seen
+        out = self.sim.execute(seen.points[index], seen.motion_to_world(motion), normal=seen.normals[index])
         name, obj = self.config.primitive, self.sim.obj
         reward = -rewards.loss(name, out.pose_before, out.pose_after, self.params, obj)
         success = rewards.success(name, out.pose_before, out.pose_after, self.params, obj)

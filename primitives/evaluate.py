@@ -164,7 +164,7 @@ def plot_critic_map(model: HybridActorCritic, primitive: str, path: str | os.Pat
     env = PrimitiveEnv(EnvConfig(primitive, objects=(object_name,), episodes_per_object=1), seed=seed)
     obs = env.reset(object_key=object_name)
     idx, motion, q = greedy_action(model, obs)
-    pts = env.points
+    pts, motion = env.points, env.seen.motion_to_world(motion)
     fig = plt.figure(figsize=(6, 5))
     ax = fig.add_subplot(projection="3d")
     sc = ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], c=q, cmap="viridis", s=6)

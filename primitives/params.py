@@ -13,6 +13,20 @@ where ``T_param`` is the rigid motion the parameter names: a 5 cm translation al
 (push), a rotation by the angle about the vertical through the centre of mass (spin), or the
 smallest tip that brings the target state's up-vector to +z, about the centre of mass, plus the
 change of height (roll). ``None`` asks for nothing: the flow is zero.
+
+**Goal frame** (:func:`goal_frame`): the policy sees the cloud, its normals and the flow in a frame
+that makes the request canonical, ``A_frame_world`` (3x3, orthogonal, keeps the vertical):
+
+- push: rotated about z so that the asked direction is +x: every push is "push along +x";
+- spin: mirrored (``y -> -y``) when the asked turn is clockwise: every spin is counter-clockwise;
+- roll: rotated about z so that the face that should end up *up* points along +x: every roll tips
+  the object the same way (its top moves towards -x);
+- ``None``: the world frame.
+
+The table and the physics are invariant under rotations about z and under reflections through a
+vertical plane (friction is isotropic; a mirrored object is still an object), so this loses nothing and
+spares the policy from learning those symmetries from samples, which a 2-core training budget cannot
+afford. The policy's motion comes back through ``A_frame_world.T``.
 """
 
 from __future__ import annotations
@@ -101,10 +115,18 @@ def sample(skill: str, rng: np.random.Generator, obj: ObjectModel, state: int, p
     return {"target": int(rng.choice(targets))} if targets else None
 
 
+def target_up(obj: ObjectModel, R_world_object: np.ndarray, target: int) -> np.ndarray:
+    """World-frame direction that must turn to +z for the object to rest in state ``target``.
+
+    Of the state's symmetric members, the one needing the smallest tip.
+    """
+    ups_world = obj.resting_states[target].member_ups @ np.asarray(R_world_object).T
+    return ups_world[int(np.argmax(ups_world[:, 2]))]
+
+
 def roll_rotation(obj: ObjectModel, R_world_object: np.ndarray, target: int) -> np.ndarray:
     """The smallest world-frame rotation (3x3) that brings resting state ``target`` face-down."""
-    ups_world = obj.resting_states[target].member_ups @ np.asarray(R_world_object).T
-    up = ups_world[int(np.argmax(ups_world[:, 2]))]  # the member needing the smallest tip
+    up = target_up(obj, R_world_object, target)
     rot, _ = Rotation.align_vectors(WORLD_Z[None], up[None])
     return rot.as_matrix()
 
@@ -131,6 +153,23 @@ def goal_transform(skill: str, params: dict | None, T_world_object: np.ndarray,
     T[:3, :3] = R
     T[:3, 3] = c - R @ c + np.array([0.0, 0.0, dz])
     return T
+
+
+def goal_frame(skill: str, params: dict | None, T_world_object: np.ndarray,
+               obj: ObjectModel | None = None) -> np.ndarray:
+    """``A_frame_world``: the 3x3 map from world vectors to the policy's goal frame (module docstring)."""
+    if params is None:
+        return np.eye(3)
+    if skill == "push":
+        return rot_z(-params["direction"])
+    if skill == "spin":
+        return np.diag([1.0, -1.0, 1.0]) if params["angle"] < 0 else np.eye(3)
+    if obj is None:
+        raise InputError("a roll goal needs the object model")
+    up = target_up(obj, np.asarray(T_world_object)[:3, :3], params["target"])
+    if math.hypot(up[0], up[1]) < 1e-9:  # already up: nothing to tip, any yaw will do
+        return np.eye(3)
+    return rot_z(-math.atan2(up[1], up[0]))
 
 
 def goal_flow(skill: str, params: dict | None, points: np.ndarray, T_world_object: np.ndarray,

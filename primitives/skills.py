@@ -22,7 +22,7 @@ import torch
 from affordplan.errors import InputError
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
-from primitives.env import PRIMITIVES, skill_observation
+from primitives.env import PRIMITIVES, SkillObservation, skill_observation
 from primitives.evaluate import greedy_action, load_policy
 from primitives.networks import HybridActorCritic
 from primitives.success import SuccessModel, load_success_net
@@ -39,17 +39,17 @@ class Skill:
         self._success_weights = success_weights
         self._success: SuccessModel | None = None
 
-    def observe(self, sim: Simulator, params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
-        """Cloud, normals, the policy's observation and the checked params (raises InputError)."""
+    def observe(self, sim: Simulator, params=None) -> SkillObservation:
+        """Cloud, the policy's observation, the checked params and the goal frame (raises InputError)."""
         return skill_observation(sim, self.name, params, self.n_points)
 
     def _decide(self, sim: Simulator, params) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
-        points, normals, obs, params = self.observe(sim, params)
-        idx, motion, _ = greedy_action(self.model, obs)
-        return points[idx], normals[idx], motion, params
+        seen = self.observe(sim, params)
+        idx, motion, _ = greedy_action(self.model, seen.obs)
+        return seen.points[idx], seen.normals[idx], seen.motion_to_world(motion), seen.params
 
     def act(self, sim: Simulator, params=None) -> tuple[np.ndarray, np.ndarray]:
-        """The contact point (world, metres) and motion in [-1, 1]^3 the policy picks."""
+        """The contact point (world, metres) and world-frame motion in [-1, 1]^3 the policy picks."""
         contact, _, motion, _ = self._decide(sim, params)
         return contact, motion
 
@@ -68,8 +68,7 @@ class Skill:
 
     def success_probability(self, sim: Simulator, params=None) -> float:
         """Predicted probability that ``execute(sim, params)`` succeeds now (no physics is run)."""
-        _, _, obs, _ = self.observe(sim, params)
-        return float(self.success_model.predict(obs))
+        return float(self.success_model.predict(self.observe(sim, params).obs))
 
     def success_probability_obs(self, obs: np.ndarray) -> np.ndarray:
         """Predicted P(success) for observations built with :func:`primitives.env.skill_observation`."""

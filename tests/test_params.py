@@ -102,3 +102,42 @@ def test_sample_covers_the_ranges():
     rolls = {params.sample("roll", rng, cube, 0, 1.0)["target"] for _ in range(100)}
     assert rolls == set(params.roll_targets(cube, 0))
     assert sum(params.sample("push", rng, cube, 0, 0.5) is None for _ in range(400)) in range(160, 240)
+
+
+def test_goal_frame_makes_each_request_canonical():
+    cube = ap.load_object("cube")
+    T = cube.resting_states[0].pose((0.5, 0.1), 0.3)
+    a = 2.0
+    A = params.goal_frame("push", {"direction": a}, T)
+    assert np.allclose(A @ [math.cos(a), math.sin(a), 0.0], [1.0, 0.0, 0.0])  # the asked direction is +x
+    assert np.allclose(A.T @ A, np.eye(3)) and np.allclose(A[2], [0.0, 0.0, 1.0])
+    # Spin: a clockwise request is mirrored into a counter-clockwise one.
+    pts = T[:3, 3] + np.array([[0.05, 0.0, 0.0]])
+    for angle in (math.radians(30), -math.radians(30)):
+        A = params.goal_frame("spin", {"angle": angle}, T)
+        flow_frame = params.goal_flow("spin", {"angle": angle}, pts, T) @ A.T
+        offset_frame = (pts - T[:3, 3]) @ A.T
+        assert np.cross(offset_frame[0], flow_frame[0])[2] > 0  # counter-clockwise in the goal frame
+    # Roll: the face that should end up up points along +x, so the top moves towards -x.
+    for target in params.roll_targets(cube, 0):
+        A = params.goal_frame("roll", {"target": target}, T, cube)
+        up_frame = A @ params.target_up(cube, T[:3, :3], target)
+        assert up_frame[0] > 0.99
+        top = T[:3, 3] + np.array([[0.0, 0.0, 0.05]])
+        assert (params.goal_flow("roll", {"target": target}, top, T, cube) @ A.T)[0, 0] < -0.03
+    assert np.array_equal(params.goal_frame("roll", None, T, cube), np.eye(3))
+
+
+def test_goal_frame_motion_reaches_the_world():
+    """A goal-frame push along +x, from the point the frame puts last along x, moves the cube along the direction."""
+    from primitives.env import skill_observation
+
+    sim = ap.Simulator(ap.load_object("cube"), seed=0)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    seen = skill_observation(sim, "push", {"direction": math.pi / 2}, 256)
+    assert np.allclose(seen.obs[:, 6:9], [0.05, 0.0, 0.0], atol=1e-6)  # the flow is "+x" for every point
+    mid = np.abs(seen.obs[:, 2] - 0.03) < 0.015
+    i = int(np.flatnonzero(mid)[np.argmin(seen.obs[mid, 0])])
+    out = sim.execute(seen.points[i], seen.motion_to_world([1.0, 0.0, 0.0]), normal=seen.normals[i])
+    moved = out.pose_after[:3, 3] - out.pose_before[:3, 3]
+    assert 0.04 < moved[1] < 0.12 and abs(moved[0]) < 0.02  # along world +y, the asked direction
