@@ -20,9 +20,11 @@ Read top to bottom, CleanRL style. Choices and why:
   policy serves both. ``--init`` warm-starts from earlier weights (weights without the flow inputs
   are widened with zero weights, so the run starts from what they did).
 - **Invalid samples are dropped.** Primitives flagged by the physics guards never enter the replay.
-- **Workers.** ``--workers K`` runs K rollout processes (one torch thread each) that act with the
-  latest weights and send transitions to this learner; ``--workers 0`` collects in-process and is
-  bit-for-bit reproducible for a given ``--seed``.
+- **Workers.** ``--workers K`` runs K rollout workers (one torch thread each) that act with the
+  latest weights and send transitions to this learner (:mod:`primitives.rollouts`): processes on
+  this machine (``--backend local``) or Ray actors on a local Ray instance or a Ray cluster
+  (``--backend ray [--ray-address ADDR]``; ``docs/training.md``). Both seed worker ``w`` the same
+  way. ``--workers 0`` collects in-process and is bit-for-bit reproducible for a given ``--seed``.
 - **Memory stays flat.** The replay is preallocated (float16 clouds); nothing grows with the run.
 - **Checkpoints** are written atomically every ``--checkpoint-minutes`` and at the end, with the
   replay, optimisers and random-generator states; ``--resume`` continues from the last one.
@@ -33,9 +35,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import multiprocessing as mp
-import os
-import queue
 import resource
 import time
 from collections import deque
@@ -47,10 +46,12 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
+from affordplan.errors import InputError
 from primitives import checkpoint as ckpt
 from primitives.env import PRIMITIVES, EnvConfig, PrimitiveEnv
-from primitives.networks import HybridActorCritic, choose_contact
+from primitives.networks import HybridActorCritic
 from primitives.replay import ReplayBuffer
+from primitives.rollouts import BACKENDS, Exploration, act, import_ray, make_source, rss_mb
 
 
 @dataclass
@@ -58,6 +59,8 @@ class TrainConfig:
     primitive: str = "push"
     steps: int = 60_000  # environment steps (primitives executed) in total
     workers: int = 1
+    backend: str = "local"  # where the workers run: "local" processes or "ray" actors
+    ray_address: str | None = None  # None: start a local Ray instance; "auto" or "ray://host:port": a cluster
     seed: int = 0
     out: str = "runs/push"
     max_minutes: float = 60.0
@@ -86,35 +89,19 @@ def env_config(cfg: TrainConfig) -> EnvConfig:
                      p_params=cfg.p_params)
 
 
-# ---------------------------------------------------------------------------- acting
-def act(model: HybridActorCritic, obs: np.ndarray, cfg: TrainConfig, rng: np.random.Generator,
-        gen: torch.Generator) -> tuple[int, np.ndarray]:
-    """Exploring contact index and motion for one observation (greedy acting: evaluate.greedy_action)."""
-    actions, q = model.maps(torch.from_numpy(obs)[None])
-    idx = int(choose_contact(q, cfg.temperature, cfg.epsilon, gen, greedy=False)[0])
-    motion = actions[0, idx].numpy().astype(np.float64)
-    return idx, np.clip(motion + rng.normal(0.0, cfg.motion_noise, size=3), -1.0, 1.0)
+def exploration(cfg: TrainConfig) -> Exploration:
+    """How the training policy explores (workers and the in-process collector alike)."""
+    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise)
 
 
-def rollout_worker(wid: int, cfg: TrainConfig, seed: int, weights_q: mp.Queue, out_q: mp.Queue, stop) -> None:
-    """Collect transitions with the latest weights until ``stop`` is set."""
-    torch.set_num_threads(1)
-    env = PrimitiveEnv(env_config(cfg), seed=seed)
-    rng = np.random.default_rng(seed + 1)
-    gen = torch.Generator().manual_seed(seed + 2)
-    model = HybridActorCritic()
-    model.load_state_dict(weights_q.get())
-    while not stop.is_set():
-        try:
-            while True:
-                model.load_state_dict(weights_q.get_nowait())
-        except queue.Empty:
-            pass
-        obs = env.reset()
-        idx, motion = act(model, obs, cfg, rng, gen)
-        res = env.step(idx, motion)
-        out_q.put((obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid))
-    env.close()
+def check_config(cfg: TrainConfig) -> None:
+    """Raise :class:`InputError` for a backend / workers / address combination that cannot run."""
+    if cfg.backend not in BACKENDS:
+        raise InputError(f"unknown backend {cfg.backend!r}; expected one of {BACKENDS}")
+    if cfg.backend == "ray" and cfg.workers < 1:
+        raise InputError("the ray backend runs one Ray actor per worker: give --workers 1 or more")
+    if cfg.ray_address is not None and cfg.backend != "ray":
+        raise InputError("--ray-address needs --backend ray")
 
 
 # ---------------------------------------------------------------------------- learning
@@ -145,19 +132,8 @@ def update(model, opt_critic, opt_actor, batch, cfg: TrainConfig, n_updates: int
     return float(critic_loss.detach()), actor_loss
 
 
-def rss_mb(pid: int | None = None) -> float:
-    """Resident memory of a process in MB (Linux /proc; 0 where unavailable)."""
-    try:
-        with open(f"/proc/{pid or os.getpid()}/status") as f:
-            for line in f:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1]) / 1024.0
-    except OSError:
-        pass
-    return 0.0
-
-
 def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict:
+    check_config(cfg)
     out = Path(cfg.out)
     out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(cfg.torch_threads)
@@ -186,19 +162,11 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
         state.update(saved["state"])
     (out / "config.json").write_text(json.dumps(asdict(cfg), indent=2))
 
-    env = None
-    workers, weights_qs, out_q, stop = [], [], None, None
-    if cfg.workers > 0:
-        ctx = mp.get_context("spawn")
-        out_q, stop = ctx.Queue(maxsize=4096), ctx.Event()
-        for w in range(cfg.workers):
-            wq = ctx.Queue()
-            wq.put(model.state_dict())
-            seed = cfg.seed * 1000 + 17 * (w + 1) + state["global_step"]  # fresh streams after a resume
-            p = ctx.Process(target=rollout_worker, args=(w, cfg, seed, wq, out_q, stop), daemon=True)
-            p.start()
-            workers.append(p)
-            weights_qs.append(wq)
+    env, source = None, None
+    explore = exploration(cfg)
+    if cfg.workers > 0:  # worker seeds are offset by the step count: fresh streams after a resume
+        source = make_source(cfg.backend, cfg.workers, env_config(cfg), explore, cfg.seed, state["global_step"],
+                             model.state_dict(), ray_address=cfg.ray_address)
     else:
         env = PrimitiveEnv(env_config(cfg), seed=cfg.seed + state["global_step"])
 
@@ -234,17 +202,13 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
             # 1. Collect.
             if env is not None:
                 obs = env.reset()
-                idx, motion = act(model, obs, cfg, rng, gen)
+                idx, motion = act(model, obs, explore, rng, gen)
                 res = env.step(idx, motion)
                 add(obs, idx, motion, res.reward, res.success, res.valid)
-            else:
-                got = 0
-                while True:
-                    try:
-                        add(*out_q.get(timeout=0.5 if got == 0 and replay.size < cfg.learning_starts else 0))
-                        got += 1
-                    except queue.Empty:
-                        break
+            else:  # whatever the workers have sent; transitions beyond the step budget are dropped
+                for transition in source.poll(timeout=0.5 if replay.size < cfg.learning_starts else 0.0):
+                    if state["global_step"] < cfg.steps:
+                        add(*transition)
             # 2. Learn, at most replay_ratio samples per collected transition.
             budget = cfg.replay_ratio * (state["global_step"] - state["invalid"]) / cfg.batch_size
             if replay.size >= cfg.learning_starts:
@@ -255,10 +219,8 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
                     critic_loss, a_loss = update(model, opt_critic, opt_actor,
                                                  replay.sample(cfg.batch_size, rng), cfg, state["n_updates"])
                     actor_loss = a_loss if a_loss is not None else actor_loss
-                    if workers and state["n_updates"] % cfg.weight_sync_updates == 0:
-                        weights = {k: v.clone() for k, v in model.state_dict().items()}
-                        for wq in weights_qs:
-                            wq.put(weights)
+                    if source is not None and state["n_updates"] % cfg.weight_sync_updates == 0:
+                        source.push_weights(model.state_dict())
                 if n == 0 and env is None:
                     time.sleep(0.01)
             # 3. Log.
@@ -266,7 +228,7 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
                 minutes = (time.time() - t_start) / 60
                 sps = (state["global_step"] - last_log_step) / max(1e-9, time.time() - t_last_log)
                 t_last_log = time.time()
-                rss = rss_mb() + sum(rss_mb(p.pid) for p in workers)
+                rss = rss_mb() + (source.worker_rss_mb() if source is not None else 0.0)
                 state["rss_samples"].append((state["global_step"], minutes, rss))
                 succ = float(np.mean(recent_success)) if recent_success else 0.0
                 rew = float(np.mean(recent_reward)) if recent_reward else 0.0
@@ -288,12 +250,8 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
                 _save(ckpt_path, model, opt_critic, opt_actor, replay, rng, gen, state, cfg)
                 t_ckpt = time.time()
     finally:
-        if stop is not None:
-            stop.set()
-            for p in workers:
-                p.join(timeout=5)
-                if p.is_alive():
-                    p.terminate()
+        if source is not None:
+            source.close()
         bar.close()
         log_file.close()
         if tb is not None:
@@ -332,13 +290,22 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="examples:\n"
                "  python -m primitives.train push --steps 60000 --workers 1 --out runs/push\n"
                "  python -m primitives.train push --out runs/push --resume      # after a crash\n"
-               "  python -m primitives.train roll --steps 2000 --workers 0 --out /tmp/roll  # reproducible",
+               "  python -m primitives.train roll --steps 2000 --workers 0 --out /tmp/roll  # reproducible\n"
+               "  python -m primitives.train push --backend ray --workers 4 --out runs/push  # local Ray instance\n"
+               "  python -m primitives.train push --backend ray --ray-address auto --workers 32  # Ray cluster\n"
+               "see docs/training.md",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     d = TrainConfig()
     p.add_argument("primitive", choices=PRIMITIVES)
     p.add_argument("--steps", type=int, default=d.steps, help="primitives to execute (default: %(default)s)")
-    p.add_argument("--workers", type=int, default=d.workers, help="rollout processes; 0 = in-process")
+    p.add_argument("--workers", type=int, default=d.workers,
+                   help="rollout workers (processes, or Ray actors with --backend ray); 0 = in-process")
+    p.add_argument("--backend", choices=BACKENDS, default=d.backend,
+                   help="where the workers run: local processes or Ray actors (default: %(default)s)")
+    p.add_argument("--ray-address", default=None,
+                   help="Ray cluster to join: 'auto' (this node ran `ray start`) or 'ray://HOST:10001'; "
+                        "default: start a local Ray instance")
     p.add_argument("--seed", type=int, default=d.seed)
     p.add_argument("--out", default=None, help="run folder (default: runs/PRIMITIVE)")
     p.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
@@ -351,20 +318,30 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--replay-size", type=int, default=d.replay_size)
     p.add_argument("--learning-starts", type=int, default=d.learning_starts)
     p.add_argument("--checkpoint-minutes", type=float, default=d.checkpoint_minutes)
+    p.add_argument("--weight-sync-updates", type=int, default=d.weight_sync_updates,
+                   help="send the weights to the workers every this many updates (default: %(default)s)")
     p.add_argument("--n-points", type=int, default=d.n_points)
     p.add_argument("--torch-threads", type=int, default=d.torch_threads, help="learner threads")
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
     cfg = TrainConfig(
-        primitive=args.primitive, steps=args.steps, workers=args.workers, seed=args.seed,
+        primitive=args.primitive, steps=args.steps, workers=args.workers, backend=args.backend,
+        ray_address=args.ray_address, seed=args.seed,
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
         checkpoint_minutes=args.checkpoint_minutes, n_points=args.n_points, torch_threads=args.torch_threads,
-        p_params=args.p_params, init=args.init,
+        p_params=args.p_params, init=args.init, weight_sync_updates=args.weight_sync_updates,
     )
+    try:
+        check_config(cfg)
+        if cfg.backend == "ray":
+            import_ray()  # the optional dependency: fail now, saying how to install it
+    except (InputError, ImportError) as exc:
+        parser.error(str(exc))
     summary = train(cfg, resume=args.resume)
     print(json.dumps({k: v for k, v in summary.items() if k != "rss_samples"}, indent=2))
     return 0
