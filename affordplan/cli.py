@@ -1,28 +1,99 @@
-"""The ``affordplan`` command line."""
+"""The ``affordplan`` command line: ``demo``, ``plan``, ``render``, ``affordances``, ``bench``.
+
+Every subcommand has ``--help`` with examples. Library errors (bad input, no plan) print one line
+``affordplan: error: ...`` and exit with status 2; a run that finishes exits 0 whether or not the goal
+was reached (``--check`` makes an unreached goal exit 1).
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
 import sys
+import textwrap
 
 EXAMPLES = """\
 examples:
-  affordplan demo                          # the mug, three primitives, ./affordplan-demo/demo.png
-  affordplan demo --object cube --out /tmp/demo
+  affordplan demo                          # the mug: flip upright, through the gap, turn; ./affordplan-demo/
+  affordplan demo --max-primitives 10 --camera overview --out /tmp/demo
+  affordplan plan examples/scenes/mug_wall.json --out /tmp/mug_wall
+  affordplan plan examples/scenes/box_corridor.yaml --sim finger --planner greedy
+  affordplan render mug --out mug_states.png   # the object in each of its resting states
+  affordplan affordances lunch_box --plot lunch_box.png   # predicted vs measured success per state
   affordplan bench sim                     # primitives per second and overhead over raw physics
-  affordplan bench sim --object mug -n 1000 --json
   affordplan bench sim --pusher arm        # the 7-DOF arm through mink IK
   affordplan bench sim2sim -n 100          # the same primitives by finger and arm: outcome gap
   affordplan bench plan --tasks 50 --sim arm   # plan-and-execute success, affordplan vs greedy
-  affordplan affordances lunch_box --plot lunch_box.png   # predicted vs measured success per state
+
+Run `affordplan COMMAND --help` for a command's options.
 """
+
+RUN_OUTPUTS = """\
+outputs (in --out):
+  video.mp4     the execution rendered offscreen (video.gif when ffmpeg is unavailable)
+  plan.png      top-down: obstacles, planned footprints and steps, the executed path
+  frames.png    frames after primitives, start and end included
+  summary.json  the scene, the plan, the execution log, the final errors
+"""
+
+SCENE_FORMAT = """\
+scene file (JSON, or YAML with PyYAML; metres, radians, or degrees in fields ending in _deg):
+  {"object": "mug",                                   # catalogue name or mesh path
+   "start": {"resting_state": 0, "xy": [0.45, -0.05], "yaw": 0.5},
+   "goal": {"xy": [0.69, 0.0], "resting_state": 1, "yaw_deg": 90},   # yaw, state optional
+   "obstacles": [{"center": [0.6, -0.21], "size": [0.02, 0.2, 0.1]}]}
+  optional: "name", "description", "size" (object half-extent, m), goal "xy_tol", "yaw_tol(_deg)",
+  obstacle "yaw(_deg)". `affordplan render OBJECT` shows the resting-state indices.
+"""
+
+
+def _formatter(prog: str) -> argparse.HelpFormatter:
+    return argparse.RawDescriptionHelpFormatter(prog, max_help_position=32)
+
+
+def _wrap(text: str) -> str:
+    """A description wrapped at 100 columns (the raw formatter keeps the epilogs' layout as written)."""
+    return textwrap.fill(text, width=100)
+
+
+# ------------------------------------------------------------------------------ commands
+def _run_kwargs(args: argparse.Namespace) -> dict:
+    return dict(sim=args.sim, planner=args.planner, max_primitives=args.max_primitives, seed=args.seed,
+                time_limit=args.time_limit, video=not args.no_video, width=args.width, height=args.height,
+                fps=args.fps, frame_interval=args.frame_interval, camera=args.camera, viewer=args.viewer,
+                progress=not args.quiet)
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     from affordplan.demo import run_demo
 
-    run_demo(args.out, object_name=args.object, seed=args.seed, render=not args.no_render)
+    run = run_demo(args.out, **_run_kwargs(args))
+    return 1 if args.check and not run.success else 0
+
+
+def _cmd_plan(args: argparse.Namespace) -> int:
+    from affordplan.demo import run_scene
+    from affordplan.scene_file import load_scene
+
+    scene = load_scene(args.scene)
+    run = run_scene(scene, args.out or f"affordplan-plan/{scene.name}", **_run_kwargs(args))
+    return 1 if args.check and not run.success else 0
+
+
+def _cmd_render(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from affordplan.objects.model import load_object
+    from affordplan.render import render_states, save_states_picture, state_label
+
+    obj = load_object(args.object, size=args.size)
+    print(f"{obj.name}: {len(obj.resting_states)} resting states (most likely first)")
+    for s in obj.resting_states:
+        print(f"  {state_label(obj, s.index)}  COM height {100 * s.height:.1f} cm")
+    images = render_states(obj, args.state, width=args.width, height=args.height)
+    out = Path(args.out or f"{Path(obj.name).stem}_states.png")
+    save_states_picture(obj, images, out)
+    print(f"wrote {out}")
     return 0
 
 
@@ -74,36 +145,158 @@ def _cmd_affordances(args: argparse.Namespace) -> int:
     return 0
 
 
+# -------------------------------------------------------------------------------- parser
+def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_primitives: int) -> None:
+    """Options shared by ``demo`` and ``plan``: execution, video, viewer."""
+    p.add_argument("--out", default=out_default, metavar="DIR",
+                   help="output folder (default: %s)" % (out_default or "affordplan-plan/<scene name>"))
+    p.add_argument("--sim", default="arm", choices=["arm", "finger"],
+                   help="pusher: the 7-DOF arm (mink IK) or the faster fingertip (default: %(default)s)")
+    p.add_argument("--planner", default="affordplan", choices=["affordplan", "greedy"],
+                   help="the planner, or the reactive greedy baseline (default: %(default)s)")
+    p.add_argument("--max-primitives", type=_positive_int, default=max_primitives, metavar="N",
+                   help="stop executing after N skill calls (default: %(default)s)")
+    p.add_argument("--time-limit", type=float, default=5.0, metavar="S",
+                   help="seconds per planning call (default: %(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="seeds the planner and the point clouds (default: %(default)s)")
+    video = p.add_argument_group("video")
+    video.add_argument("--no-video", "--no-render", dest="no_video", action="store_true",
+                       help="skip rendering: only plan.png and summary.json are written")
+    video.add_argument("--camera", default=None, choices=["arm", "overview", "wide", "top"],
+                       help="arm: the whole arm; overview: closer on the object (default: arm with --sim arm, "
+                            "overview with --sim finger)")
+    video.add_argument("--width", type=_positive_int, default=480, help="frame width, pixels (default: %(default)s)")
+    video.add_argument("--height", type=_positive_int, default=360, help="frame height, pixels (default: %(default)s)")
+    video.add_argument("--fps", type=float, default=10.0, help="video frame rate (default: %(default)s)")
+    video.add_argument("--frame-interval", type=float, default=0.25, metavar="S",
+                       help="simulated seconds between frames (default: %(default)s)")
+    p.add_argument("--viewer", action="store_true",
+                   help="also show MuJoCo's interactive viewer (needs a display; on macOS run under mjpython)")
+    p.add_argument("--check", action="store_true", help="exit with status 1 when the goal is not reached")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+    return value
+
+
+def _register_robustness(bench_sub) -> None:
+    """``affordplan bench robustness ...`` when :mod:`affordplan.robustness` exists (it is optional)."""
+    import importlib
+
+    try:
+        robustness = importlib.import_module("affordplan.robustness")
+    except ModuleNotFoundError as exc:
+        if exc.name != "affordplan.robustness":  # it exists but needs something missing: say so
+            raise
+        return
+    robustness.register_cli(bench_sub)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="affordplan",
-        description="Plan non-prehensile manipulation (push, roll, spin) with learned primitives.",
+        description=_wrap("Plan non-prehensile manipulation (push, roll, spin) with learned primitives, execute the "
+                          "plans closed-loop in a MuJoCo simulation of a 7-DOF arm, and measure them."),
         epilog=EXAMPLES,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_formatter,
     )
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     demo = sub.add_parser(
-        "demo", help="run the demo and save pictures",
-        description="Load an object, execute a push, a roll and a spin in the MuJoCo finger sim, print "
-                    "their outcomes and the seed paper's losses, and save a before/after picture.",
-        epilog="example:\n  affordplan demo --out ./affordplan-demo",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        "demo", help="the mug on its side behind a wall: plan, execute with the arm, write a video",
+        description=_wrap("The mug lies on its side behind a wall with a gap. Plan (resting-state graph, OMPL paths, "
+                          "learned skills) to flip it upright, push it through the gap and turn it to 90 deg; execute "
+                          "the plan closed-loop in the arm sim (replanning when the mug goes off plan); print the plan "
+                          "and, honestly, whether the goal was reached (position, yaw and resting-state errors). A run "
+                          "that finishes exits 0 even when the goal is missed. About 1-3 minutes on 2 cores."),
+        epilog="examples:\n"
+               "  affordplan demo\n"
+               "  affordplan demo --out /tmp/demo --camera overview\n"
+               "  affordplan demo --max-primitives 1 --no-video   # a quick smoke test\n"
+               "  affordplan demo --viewer                        # also watch it live (needs a display)\n\n"
+               + RUN_OUTPUTS + "\nThe scene is examples/scenes/mug_wall.json; run others with `affordplan plan`.",
+        formatter_class=_formatter,
     )
-    demo.add_argument("--out", default="affordplan-demo", help="output folder (default: %(default)s)")
-    demo.add_argument("--object", default="mug", help="catalogue name or mesh path (default: %(default)s)")
-    demo.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    demo.add_argument("--no-render", action="store_true", help="skip the rendered picture")
+    _add_run_options(demo, "affordplan-demo", max_primitives=30)
     demo.set_defaults(func=_cmd_demo)
 
-    bench = sub.add_parser("bench", help="benchmarks that print figures")
-    bench_sub = bench.add_subparsers(dest="bench", required=True)
+    plan = sub.add_parser(
+        "plan", help="plan and execute a scene file (JSON / YAML), write a video and a plot",
+        description=_wrap("Read a scene (object, start, goal, obstacles), plan, execute the plan closed-loop in the "
+                          "arm sim, print the plan and the outcome, and write the same outputs as `affordplan demo`."),
+        epilog="examples:\n"
+               "  affordplan plan examples/scenes/mug_wall.json\n"
+               "  affordplan plan examples/scenes/box_corridor.yaml --out /tmp/corridor --sim finger\n"
+               "  affordplan plan my_scene.yaml --planner greedy --max-primitives 20 --check\n\n"
+               + SCENE_FORMAT + "\n" + RUN_OUTPUTS,
+        formatter_class=_formatter,
+    )
+    plan.add_argument("scene", help="scene file: .json, .yaml or .yml")
+    _add_run_options(plan, None, max_primitives=40)
+    plan.set_defaults(func=_cmd_plan)
+
+    render = sub.add_parser(
+        "render", help="picture an object in its resting states",
+        description=_wrap("Load OBJECT (a catalogue name or a mesh file), list its resting states (index, "
+                          "probability, up-vector in the object frame, centre-of-mass height) and render each, "
+                          "settled on the table, into one PNG. Scene files and goals name resting states by these "
+                          "indices."),
+        epilog="examples:\n"
+               "  affordplan render mug\n"
+               "  affordplan render pill_bottle --state 0 2 --out pill.png\n"
+               "  affordplan render path/to/mesh.obj --size 0.04 --width 240 --height 180",
+        formatter_class=_formatter,
+    )
+    render.add_argument("object", help="catalogue name (see affordplan.catalogue()) or mesh path")
+    render.add_argument("--state", type=int, nargs="+", default=None, metavar="S",
+                        help="resting-state indices to render (default: all)")
+    render.add_argument("--out", default=None, metavar="PNG", help="picture to write (default: <object>_states.png)")
+    render.add_argument("--size", type=float, default=0.05, help="largest half-extent, metres (default: %(default)s)")
+    render.add_argument("--width", type=_positive_int, default=320, help="tile width, pixels (default: %(default)s)")
+    render.add_argument("--height", type=_positive_int, default=240, help="tile height, pixels (default: %(default)s)")
+    render.set_defaults(func=_cmd_render)
+
+    aff = sub.add_parser(
+        "affordances", help="predicted vs measured success of each skill in each resting state",
+        description=_wrap("For every resting state of OBJECT: the success model's prediction for push (per "
+                          "direction sector, relative to the object's heading), spin (30 deg each way) and roll "
+                          "(to each state one roll away), next to the rate measured by executing in the finger sim."),
+        epilog="examples:\n  affordplan affordances lunch_box\n  affordplan affordances pill_bottle --trials 20 "
+               "--plot pill.png --json",
+        formatter_class=_formatter,
+    )
+    aff.add_argument("object", help="catalogue name or mesh path")
+    aff.add_argument("--trials", type=int, default=10, help="starts per action (default: %(default)s)")
+    aff.add_argument("--sectors", type=int, default=8, help="push direction sectors (default: %(default)s)")
+    aff.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    aff.add_argument("--plot", default=None, help="write a bar chart per resting state here")
+    aff.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    aff.set_defaults(func=_cmd_affordances)
+
+    bench = sub.add_parser(
+        "bench", help="benchmarks that print figures",
+        description=_wrap("Benchmarks with progress bars; each prints a report (or JSON)."),
+        epilog="examples:\n"
+               "  affordplan bench sim --object cube mug -n 500\n"
+               "  affordplan bench sim2sim -n 100\n"
+               "  affordplan bench plan --tasks 50 --sim arm",
+        formatter_class=_formatter,
+    )
+    bench_sub = bench.add_subparsers(dest="bench", required=True, metavar="BENCHMARK")
     sim = bench_sub.add_parser(
         "sim", help="primitive cost against raw physics",
-        description="Execute N random primitives and compare their wall time with the raw mj_step time "
-                    "of the same steps.",
-        epilog="examples:\n  affordplan bench sim\n  affordplan bench sim --object cube mug -n 1000 --json",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=_wrap("Execute N random primitives and compare their wall time with the raw mj_step time "
+                          "of the same steps."),
+        epilog="examples:\n  affordplan bench sim\n  affordplan bench sim --object cube mug -n 1000 --json\n"
+               "  affordplan bench sim --pusher arm -n 100",
+        formatter_class=_formatter,
     )
     sim.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     sim.add_argument("-n", type=int, default=500, help="primitives per object (default: %(default)s)")
@@ -114,10 +307,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     s2s = bench_sub.add_parser(
         "sim2sim", help="finger vs arm on the same random primitives",
-        description="Run the same random primitives with the finger and with the arm and print how far "
-                    "the object's final poses differ (mean and 90th percentile).",
+        description=_wrap("Run the same random primitives with the finger and with the arm and print how far "
+                          "the object's final poses differ (mean and 90th percentile)."),
         epilog="example:\n  affordplan bench sim2sim --object cube mug -n 100",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_formatter,
     )
     s2s.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     s2s.add_argument("-n", type=int, default=100, help="primitives per object (default: %(default)s)")
@@ -126,35 +319,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     bp = bench_sub.add_parser(
         "plan", help="plan-and-execute success on random tasks, affordplan vs greedy",
-        description="Random tasks (walls with gaps, blocks, face changes, goal yaw) on objects never trained "
-                    "on; prints success, median planning time, primitives and replans per task for each planner.",
-        epilog="example:\n  affordplan bench plan --tasks 50 --sim arm --seed 0",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=_wrap("Random tasks (walls with gaps, blocks, face changes, goal yaw) on objects never "
+                          "trained on; prints success, median planning time, primitives and replans per task for "
+                          "each planner."),
+        epilog="examples:\n  affordplan bench plan --tasks 50 --sim arm --seed 0\n"
+               "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json",
+        formatter_class=_formatter,
     )
     bp.add_argument("--tasks", type=int, default=50, help="number of tasks (default: %(default)s)")
     bp.add_argument("--sim", default="arm", choices=["arm", "finger"], help="pusher (default: arm)")
     bp.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    bp.add_argument("--planner", nargs="+", default=["affordplan", "greedy"], choices=["affordplan", "greedy"])
+    bp.add_argument("--planner", nargs="+", default=["affordplan", "greedy"], choices=["affordplan", "greedy"],
+                    help="planners to compare (default: both)")
     bp.add_argument("--max-primitives", type=int, default=40, help="per task (default: %(default)s)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
-
-    aff = sub.add_parser(
-        "affordances", help="predicted vs measured success of each skill in each resting state",
-        description="For every resting state of OBJECT: the success model's prediction for push (per "
-                    "direction sector, relative to the object's heading), spin (30 deg each way) and roll "
-                    "(to each state one roll away), next to the rate measured by executing in the finger sim.",
-        epilog="examples:\n  affordplan affordances lunch_box\n  affordplan affordances pill_bottle --trials 20 "
-               "--plot pill.png --json",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    aff.add_argument("object", help="catalogue name or mesh path")
-    aff.add_argument("--trials", type=int, default=10, help="starts per action (default: %(default)s)")
-    aff.add_argument("--sectors", type=int, default=8, help="push direction sectors (default: %(default)s)")
-    aff.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    aff.add_argument("--plot", default=None, help="write a bar chart per resting state here")
-    aff.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    aff.set_defaults(func=_cmd_affordances)
+    _register_robustness(bench_sub)
     return parser
 
 

@@ -1,150 +1,329 @@
-"""``affordplan demo``: the mug on the table, three primitives, their outcomes and the seed's losses.
+"""``affordplan demo`` and ``affordplan plan SCENE``: plan, execute in the arm sim, film, report.
 
-Until the learned skills ship, the demo picks contacts by hand from the point cloud (a push on the
-end face, a roll high on the side, a spin at one end), executes them in the MuJoCo finger sim, prints
-what each did with the seed's three objectives, and saves a rendered before/after picture.
+:func:`run_scene` takes a :class:`affordplan.scene_file.Scene`, plans with :func:`affordplan.plan`,
+prints the plan, executes it closed-loop (``Plan.execute``, re-observing and replanning after every
+primitive) in a MuJoCo simulator with the 7-DOF arm (or the finger), and writes to ``out_dir``:
+
+- ``video.mp4`` (``video.gif`` when ffmpeg is unavailable): the execution rendered offscreen, one
+  frame every ``frame_interval`` simulated seconds, played at ``fps``;
+- ``plan.png``: a top-down plot of the obstacles, the planned footprints and steps, and the executed path;
+- ``frames.png``: a strip of frames taken after primitives (start and end included);
+- ``summary.json``: the scene, the plan, the execution log and the final errors.
+
+It prints honestly whether the goal was reached, with the position, yaw and resting-state errors.
+:func:`run_demo` runs the embedded demo scene (:data:`affordplan.scene_file.DEMO_SCENE`): the mug on
+its side behind a wall with a gap, to be flipped upright, pushed through the gap and turned to 90 deg.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import time
-import warnings
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from affordplan.objects.model import load_object
+from affordplan.errors import InputError
+from affordplan.geometry import transform_points
+from affordplan.goal import Goal
+from affordplan.objects.model import ObjectModel
+from affordplan.scene_file import Scene, demo_scene
 from affordplan.sim.simulator import Outcome, Simulator
-from primitives import rewards
+from affordplan.video import FrameRecorder, chain_hooks, save_strip, write_video
+
+DEMO_MAX_PRIMITIVES = 30  # bounds the demo's time: ~1-3 s per arm primitive with frames on 2 cores
+END_HOLD_S = 1.0  # the video holds its last frame this long
+OFF_TABLE_HEIGHT = 0.01  # metres: a settled object whose lowest point is higher than this is not on the table
+
+if TYPE_CHECKING:  # the planner is imported lazily (affordplan core <- primitives <- planner)
+    from planner.execute import Execution
+    from planner.plan import Plan
 
 
-@dataclass(frozen=True)
-class ScriptedPrimitive:
-    name: str  # push, roll or spin: the objective it aims at
-    direction: tuple[float, float]  # unit push direction on the table, world frame
-    height: float  # contact height as a fraction of the object's height above the table (0..1)
-    offset: float  # lateral offset as a fraction of the half-width across the direction (-1..1)
-    stroke: float  # motion magnitude in [0, 1]
-    state: int = 0  # resting state to start from
+class _NotifyingSimulator(Simulator):
+    """A :class:`Simulator` that calls ``after_primitive(self)`` after every :meth:`execute`, even a failed one."""
 
+    after_primitive: Callable[[Simulator], None] | None = None
 
-def scripted_action(sim: Simulator, p: ScriptedPrimitive, n_points: int = 2048):
-    """Contact, normal and motion for a hand-scripted primitive, from the observed point cloud."""
-    points, normals = sim.point_cloud(n_points)
-    d = np.array([p.direction[0], p.direction[1], 0.0])
-    d /= np.linalg.norm(d)
-    lateral = np.cross([0.0, 0.0, 1.0], d)
-    centre = sim.object_pose()[:3, 3]
-    behind = (points - centre) @ d < 0.0  # on the finger's side of the object ...
-    facing = behind & (normals @ -d > 0.5)  # ... and facing it (not the inside of a cup)
-    if not facing.any():
-        facing = behind
-    top = points[:, 2].max()
-    half_width = np.abs((points - centre) @ lateral).max()
-    want_z = p.height * top
-    want_lat = p.offset * half_width
-    cost = np.abs(points[:, 2] - want_z) + np.abs((points - centre) @ lateral - want_lat)
-    cost[~facing] = np.inf
-    i = int(np.argmin(cost))
-    return points[i], normals[i], p.stroke * d
-
-
-def _describe(out: Outcome) -> dict:
-    m = rewards.motion(out.pose_before, out.pose_after)
-    return dict(
-        moved_cm=100 * m.p_xy, turned_deg=m.theta_deg, axis_z=m.wz, valid=out.valid,
-        approach_ok=out.approach_ok, steps=out.n_steps,
-        **{f"{k}_loss": f(out.pose_before, out.pose_after) for k, f in rewards.LOSSES.items()},
-        **{f"{k}_ok": f(out.pose_before, out.pose_after) for k, f in rewards.SUCCESSES.items()},
-    )
-
-
-DEMO_PRIMITIVES = (
-    ScriptedPrimitive("push", (1.0, 0.0), height=0.45, offset=0.0, stroke=0.8),
-    ScriptedPrimitive("roll", (0.0, 1.0), height=1.0, offset=0.0, stroke=1.0, state=2),  # tip it over
-    ScriptedPrimitive("spin", (0.0, 1.0), height=0.45, offset=-0.85, stroke=1.0),
-)
-
-
-def run_demo(out_dir: str | Path = "affordplan-demo", object_name: str = "mug", seed: int = 0,
-             render: bool = True, echo=print) -> list[dict]:
-    """Run the demo; returns one row per primitive and writes ``demo.png`` to ``out_dir``."""
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
-    obj = load_object(object_name)
-    states = obj.resting_states
-    echo(f"{obj}")
-    echo("resting states: " + ", ".join(
-        f"#{s.index} p={s.probability:.2f}{' (rolls)' if s.is_rolling_family else ''}" for s in states))
-    sim = Simulator(obj, seed=seed)
-    renderer = _Pictures(sim) if render else None
-    frames = []
-    rows = []
-    for prim in DEMO_PRIMITIVES:
-        sim.reset(resting_state=min(prim.state, len(states) - 1), xy=(0.5, 0.0), yaw=0.0)
-        before = renderer.take() if renderer else None
-        contact, normal, motion = scripted_action(sim, prim)
-        out = sim.execute(contact, motion, normal=normal)
-        row = dict(primitive=prim.name, **_describe(out))
-        rows.append(row)
-        after = renderer.take() if renderer else None
-        frames.append((prim.name, before, after))
-        echo(
-            f"{prim.name:5s} contact ({contact[0]:.3f}, {contact[1]:.3f}, {contact[2]:.3f}) m, "
-            f"motion ({motion[0]:+.2f}, {motion[1]:+.2f}, {motion[2]:+.2f}) -> moved {row['moved_cm']:.1f} cm, "
-            f"turned {row['turned_deg']:.0f} deg (|w.z| {row['axis_z']:.2f}), state "
-            f"{obj.classify(out.pose_before)} -> {obj.classify(out.pose_after)}"
-        )
-        echo(
-            "      seed losses  push {push_loss:.3f} {p}  roll {roll_loss:.3f} {r}  spin {spin_loss:.3f} {s}"
-            .format(**row, p=_tick(row["push_ok"]), r=_tick(row["roll_ok"]), s=_tick(row["spin_ok"]))
-        )
-    sim.close()
-    if render and all(f[1] is not None for f in frames):
-        path = out_dir / "demo.png"
-        _save_grid(frames, path)
-        echo(f"wrote {path}")
-    echo(f"demo finished in {time.perf_counter() - t0:.1f} s")
-    return rows
-
-
-def _tick(ok: bool) -> str:
-    return "success" if ok else "fail   "
-
-
-class _Pictures:
-    """Renders frames until the first failure, then stops trying (a failed GL context can abort)."""
-
-    def __init__(self, sim: Simulator):
-        self._sim = sim
-        self._ok = True
-
-    def take(self):
-        if not self._ok:
-            return None
+    def execute(self, contact, motion, normal=None) -> Outcome:
         try:
-            return self._sim.render(480, 360)
-        except Exception as exc:  # no OpenGL here: the demo still runs, without pictures
-            self._ok = False
-            warnings.warn(f"rendering unavailable ({exc}); on a headless machine set MUJOCO_GL=egl",
-                          stacklevel=2)
-            return None
+            return super().execute(contact, motion, normal=normal)
+        finally:
+            if self.after_primitive is not None:
+                self.after_primitive(self)
 
 
-def _save_grid(frames, path: Path) -> None:
-    from PIL import Image, ImageDraw
+class _Watch:
+    """Bookkeeping after every primitive: the progress bar, key frames, and whether the object left the table.
 
-    h, w = frames[0][1].shape[:2]
-    grid = Image.new("RGB", (2 * w, len(frames) * h), "white")
-    draw = ImageDraw.Draw(grid)
-    for r, (name, before, after) in enumerate(frames):
-        grid.paste(Image.fromarray(before), (0, r * h))
-        grid.paste(Image.fromarray(after), (w, r * h))
-        draw.text((8, r * h + 8), f"{name}: before", fill=(0, 0, 0))
-        draw.text((w + 8, r * h + 8), f"{name}: after", fill=(0, 0, 0))
-    grid.save(path)
+    Key frames (for ``frames.png``) are taken after primitives that simulated anything: a call the
+    arm could not reach adds none.
+    """
+
+    def __init__(self, obj: ObjectModel, recorder: FrameRecorder | None, max_primitives: int, label: str,
+                 progress: bool):
+        from tqdm import tqdm
+
+        self.recorder = recorder
+        self.hull = obj.hull.vertices
+        self.executed = 0
+        self.off_table: list[tuple[int, float]] = []
+        self.keyframes: list[tuple[str, np.ndarray]] = []
+        self._steps_seen = -1
+        self.bar = tqdm(total=max_primitives, desc=f"executing ({label})", unit="prim", disable=not progress)
+
+    def start(self, sim: Simulator) -> None:
+        self._steps_seen = sim.physics_steps
+        if self.recorder is not None and (f := self.recorder.capture()) is not None:
+            self.keyframes.append(("start", f))
+
+    def after_primitive(self, sim: Simulator) -> None:
+        self.executed += 1
+        lowest = float(np.min(transform_points(sim.object_pose(), self.hull)[:, 2]))
+        if lowest > OFF_TABLE_HEIGHT:
+            self.off_table.append((self.executed, lowest))
+        if self.recorder is not None:
+            if sim.physics_steps > self._steps_seen and (f := self.recorder.capture()) is not None:
+                self.keyframes.append((f"after primitive {self.executed}", f))
+            self.bar.set_postfix(frames=len(self.recorder.frames), refresh=False)
+        self._steps_seen = sim.physics_steps
+        self.bar.update(1)
+
+    def close(self) -> None:
+        self.bar.close()
 
 
-__all__ = ["ScriptedPrimitive", "run_demo", "scripted_action"]
+@dataclass
+class SceneRun:
+    """What :func:`run_scene` did.
+
+    Attributes:
+        scene: the scene run.
+        plan: the first plan.
+        execution: what executing it did (success, final pose, primitives, replans, log).
+        xy_error: final distance of the object's centre from the goal, metres.
+        yaw_error: final |yaw error|, radians (0 when the goal has no yaw).
+        state_ok: the final resting state is the goal's (or the goal names none).
+        final_state: the final resting state.
+        files: what was written, by kind (``video``, ``plan``, ``frames``, ``summary``).
+        wall_time: seconds, from loading the object to the last file written.
+        off_table: ``(primitive number from 1, lowest point of the object above the table in metres)``
+            after each primitive that left the object off the table (lifted by the pusher, or lying on an
+            obstacle): a physics fault the simulator's guards do not flag, reported rather than hidden.
+    """
+
+    scene: Scene
+    plan: Plan
+    execution: Execution
+    xy_error: float
+    yaw_error: float
+    state_ok: bool
+    final_state: int
+    files: dict[str, Path] = field(default_factory=dict)
+    wall_time: float = 0.0
+    off_table: list[tuple[int, float]] = field(default_factory=list)
+
+    @property
+    def success(self) -> bool:
+        """The goal was reached (position, yaw and resting state within the goal's tolerances)."""
+        return bool(self.execution.success)
+
+
+def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: str = "affordplan",
+              max_primitives: int = DEMO_MAX_PRIMITIVES, seed: int = 0, time_limit: float = 5.0,
+              video: bool = True, width: int = 480, height: int = 360, fps: float = 10.0,
+              frame_interval: float = 0.25, camera: str | None = None, viewer: bool = False,
+              progress: bool = True, echo: Callable[[str], None] = print) -> SceneRun:
+    """Plan and execute ``scene``, print the plan and the outcome, write the outputs to ``out_dir``.
+
+    Args:
+        scene: what to do.
+        out_dir: output folder (created).
+        sim: ``"arm"`` (7-DOF arm, mink IK) or ``"finger"`` (the faster fingertip).
+        planner: ``"affordplan"`` or ``"greedy"`` (the reactive baseline).
+        max_primitives: execution stops after this many skill calls.
+        seed: seeds the planner and the simulator's point clouds.
+        time_limit: seconds per planning call.
+        video: render frames and write the video and the frame strip.
+        width, height: frame size, pixels.
+        fps: video frame rate (frames are ``frame_interval`` simulated seconds apart).
+        frame_interval: simulated seconds between video frames.
+        camera: ``"arm"`` (the whole arm), or a scene camera: ``"overview"`` (closer), ``"wide"``, ``"top"``;
+            ``None``: ``"arm"`` with the arm, ``"overview"`` with the finger.
+        viewer: also show MuJoCo's interactive viewer when a display exists.
+        progress: show a progress bar (primitives executed, frames rendered) on stderr.
+        echo: where the report lines go.
+
+    Raises:
+        AffordplanError: bad scene or options, or no first plan (PlanningError / GoalError).
+    """
+    import affordplan as ap
+
+    if sim not in ("arm", "finger"):
+        raise InputError(f"sim must be 'arm' or 'finger', got {sim!r}")
+    if isinstance(max_primitives, bool) or not isinstance(max_primitives, int) or max_primitives < 1:
+        raise InputError(f"max_primitives must be a positive integer, got {max_primitives!r}")
+    if not fps > 0:
+        raise InputError(f"fps must be positive, got {fps!r}")
+    t_start = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    echo(f"scene {scene.name}: {scene.description}" if scene.description else f"scene {scene.name}")
+    obj = scene.load_object()
+    echo(f"object: {obj.name}; resting states: " + ", ".join(
+        f"#{s.index} p={s.probability:.2f}" for s in obj.resting_states))
+    echo(f"start: {_describe_start(scene.start)}; goal: {_describe_goal(scene.goal)}; "
+         f"{len(scene.obstacles)} obstacles")
+
+    t_plan = time.perf_counter()
+    echo(f"planning ({planner}; loading the skills and success models first) ...")
+    plan = ap.plan(obj, scene.goal, start=scene.start, obstacles=scene.obstacles, time_limit=time_limit,
+                   planner=planner, seed=seed)
+    echo(str(plan))
+
+    t_exec = time.perf_counter()
+    simulator = _NotifyingSimulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed)
+    simulator.set_object_pose(plan.start_pose)
+    camera = camera or ("arm" if sim == "arm" else "overview")
+    recorder = FrameRecorder(simulator, width, height, camera, frame_interval) if video else None
+    live = None
+    if viewer:
+        from affordplan.viewer import open_viewer
+
+        live = open_viewer(simulator, echo=echo)
+    simulator.on_chunk = chain_hooks(recorder.on_chunk if recorder else None, live.on_chunk if live else None)
+    echo(f"executing in the {sim} sim (at most {max_primitives} primitives) ...")
+    watch = _Watch(obj, recorder, max_primitives, sim, progress)
+    watch.start(simulator)
+    simulator.after_primitive = watch.after_primitive
+    try:
+        execution = plan.execute(sim=simulator, max_primitives=max_primitives, seed=seed)
+    finally:
+        watch.close()
+        simulator.on_chunk = simulator.after_primitive = None
+    t_out = time.perf_counter()
+    echo(str(execution))
+
+    xy_error, yaw_error, state_ok = scene.goal.errors(obj, execution.final_pose)
+    run = SceneRun(scene, plan, execution, xy_error, yaw_error, state_ok, obj.classify(execution.final_pose),
+                   off_table=watch.off_table)
+    for line in outcome_lines(run, obj):
+        echo(line)
+    _write_outputs(run, obj, out, recorder, watch.keyframes, fps, t_start)
+    if live is not None:
+        echo("viewer: close its window to exit")
+        live.wait_closed()
+    if recorder is not None:
+        recorder.close()
+        if len(recorder.frames) >= recorder.max_frames:
+            echo(f"video: stopped recording at its budget of {recorder.max_frames} frames")
+        if recorder.failed:
+            echo(f"no video: rendering failed ({recorder.failed})")
+    simulator.close()
+    n_frames = len(recorder.frames) if recorder else 0
+    echo(f"wrote {', '.join(str(p) for p in run.files.values())}"
+         + (f" ({n_frames} frames at {fps:g} fps)" if n_frames else ""))
+    echo(f"finished in {time.perf_counter() - t_start:.1f} s (loading the object {t_plan - t_start:.1f} s, "
+         f"skills + planning {t_exec - t_plan:.1f} s, execution {t_out - t_exec:.1f} s, pictures and video "
+         f"{time.perf_counter() - t_out:.1f} s)")
+    return run
+
+
+def _write_outputs(run: SceneRun, obj: ObjectModel, out: Path, recorder: FrameRecorder | None,
+                   keyframes: list[tuple[str, np.ndarray]], fps: float, t_start: float) -> None:
+    """plan.png, frames.png and the video (when frames were rendered), summary.json; fills ``run.files``."""
+    from planner.plot import plot_plan
+
+    ex = run.execution
+    run.files["plan"] = out / "plan.png"
+    plot_plan(run.plan, run.files["plan"], execution=ex,
+              title=f"{run.scene.name}: {obj.name}, {'goal reached' if ex.success else 'goal NOT reached'} "
+                    f"after {ex.n_primitives} primitives, {ex.replans} replans")
+    if recorder is not None and recorder.frames:
+        run.files["frames"] = save_strip(keyframes, out / "frames.png", n=6)
+        hold = [recorder.frames[-1]] * max(1, round(END_HOLD_S * fps))
+        run.files["video"] = write_video(recorder.frames + hold, out / "video.mp4", fps=fps)
+    run.files["summary"] = out / "summary.json"
+    run.wall_time = time.perf_counter() - t_start
+    run.files["summary"].write_text(json.dumps(summary(run, obj), indent=2) + "\n", encoding="utf-8")
+
+
+def run_demo(out_dir: str | Path = "affordplan-demo", **kwargs) -> SceneRun:
+    """Run the embedded demo scene; keyword arguments as :func:`run_scene`."""
+    return run_scene(demo_scene(), out_dir, **kwargs)
+
+
+# ------------------------------------------------------------------------------- report
+def _describe_start(start: dict) -> str:
+    x, y = start["xy"]
+    return f"state {start['resting_state']} at ({x:.3f}, {y:.3f}) m, yaw {math.degrees(start['yaw']):.0f} deg"
+
+
+def _describe_goal(goal: Goal) -> str:
+    parts = [] if goal.resting_state is None else [f"state {goal.resting_state}"]
+    parts.append(f"({goal.xy[0]:.3f}, {goal.xy[1]:.3f}) m +- {100 * goal.xy_tol:.1f} cm")
+    if goal.yaw is not None:
+        parts.append(f"yaw {math.degrees(goal.yaw):.0f} +- {math.degrees(goal.yaw_tol):.0f} deg")
+    return ", ".join(parts)
+
+
+def outcome_lines(run: SceneRun, obj: ObjectModel) -> list[str]:
+    """The outcome, honestly: reached or not, and each error against its tolerance."""
+    g, ex = run.scene.goal, run.execution
+
+    def verdict(ok: bool) -> str:
+        return "ok" if ok else "NOT met"
+
+    lines = [f"outcome: goal {'REACHED' if ex.success else 'NOT reached'} after {ex.n_primitives} primitives, "
+             f"{ex.replans} replans ({ex.reason})",
+             f"  position error {100 * run.xy_error:.1f} cm (tolerance {100 * g.xy_tol:.1f} cm): "
+             f"{verdict(run.xy_error <= g.xy_tol)}"]
+    if g.yaw is not None:
+        lines.append(f"  yaw error {math.degrees(run.yaw_error):.0f} deg "
+                     f"(tolerance {math.degrees(g.yaw_tol):.0f} deg): {verdict(run.yaw_error <= g.yaw_tol)}")
+    if g.resting_state is not None:
+        lines.append(f"  resting state {run.final_state} (goal {g.resting_state}): {verdict(run.state_ok)}")
+    if run.off_table:
+        first, height = run.off_table[0]
+        top = max(h for _, h in run.off_table)
+        lines.append(f"  warning: after primitive {first} the {obj.name} was off the table, {100 * height:.0f} cm up "
+                     f"(at most {100 * top:.0f} cm; off the table after {len(run.off_table)} primitives in all): "
+                     "lifted by the pusher or left on an obstacle, which the physics guards do not flag")
+    return lines
+
+
+def summary(run: SceneRun, obj: ObjectModel) -> dict:
+    """Plain-data record of a run (for ``summary.json``)."""
+    ex, plan = run.execution, run.plan
+    state, x, y, yaw = obj.planar_pose(ex.final_pose)
+    return {
+        "scene": run.scene.as_dict(),
+        "plan": {"kind": plan.kind, "route": [int(r) for r in plan.route], "p_success": _finite(plan.p_success),
+                 "planning_time_s": plan.planning_time,
+                 "steps": [{"skill": s.skill, "params": _plain(s.params), "p_success": _finite(s.p_success)}
+                           for s in plan.steps]},
+        "execution": {"success": bool(ex.success), "n_primitives": ex.n_primitives, "replans": ex.replans,
+                      "reason": ex.reason,
+                      "log": [{"skill": e.skill, "params": _plain(e.params), "success": e.success, "valid": e.valid,
+                               "replanned": e.replanned, "note": e.note} for e in ex.log]},
+        "final": {"resting_state": int(state), "xy": [float(x), float(y)], "yaw": float(yaw),
+                  "xy_error_m": run.xy_error, "yaw_error_rad": run.yaw_error, "state_ok": bool(run.state_ok)},
+        "off_table": [{"after_primitive": k, "lowest_point_m": h} for k, h in run.off_table],
+        "files": {k: p.name for k, p in run.files.items()},
+        "wall_time_s": run.wall_time,
+    }
+
+
+def _plain(params: dict) -> dict:
+    return {k: (int(v) if isinstance(v, (int, np.integer)) else float(v)) for k, v in params.items()}
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+__all__ = ["DEMO_MAX_PRIMITIVES", "SceneRun", "outcome_lines", "run_demo", "run_scene", "summary"]

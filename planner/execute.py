@@ -115,6 +115,18 @@ def _record_frame(sim: Simulator, render, frames: list[np.ndarray]) -> None:
         frames.append(f)
 
 
+# Guard faults after which the object cannot be manipulated any further: it hangs on the pusher or lies on
+# an obstacle, it left the workspace, or the physics broke down.
+TERMINAL_FAULTS = ("off_table", "left_workspace", "nan", "unstable")
+
+
+def _terminal(out) -> str | None:
+    """Why execution must stop after ``out`` (a terminal guard fault), or ``None``."""
+    if out.invalid_reason in TERMINAL_FAULTS:
+        return f"the object can no longer be manipulated: the {out.invalid_reason!r} guard fired"
+    return None
+
+
 def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
     """Run ``plan`` closed-loop (see the module docstring)."""
     planner, goal = plan.planner, plan.goal
@@ -159,6 +171,9 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
                             out.pose_after, replanned, step.p_success))
         _record_frame(sim, render, frames)
+        if (stop := _terminal(out)) is not None:
+            reason = stop
+            break
         k += 1
     T = sim.object_pose()
     return Execution(goal.reached(obj, T), T, len(log), replans, log, reason, planning_time, frames)
@@ -202,9 +217,16 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
         best = int(np.argmin(scores))
         planning_time += time.perf_counter() - t0
         skill_name, prm = calls[best]
-        out = predictor.skills[skill_name].execute(sim, prm)
+        try:
+            out = predictor.skills[skill_name].execute(sim, prm)
+        except AffordplanError as exc:  # e.g. ReachabilityError: the arm cannot reach the chosen contact
+            log.append(LogEntry(n, skill_name, prm, False, False, T, T, False, float(p[best]), str(exc)))
+            continue
         log.append(LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
                             False, float(p[best])))
         _record_frame(sim, render, frames)
+        if (stop := _terminal(out)) is not None:
+            reason = stop
+            break
     T = sim.object_pose()
     return Execution(goal.reached(obj, T), T, len(log), 0, log, reason, planning_time, frames)

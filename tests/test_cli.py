@@ -1,28 +1,255 @@
-"""The command line: demo and bench sim do real work and report it."""
+"""The command line and what it stands on: scene files, the demo run, videos, renders, the bench."""
 
 from __future__ import annotations
 
+import copy
 import json
+import math
+import sys
+import types
+from pathlib import Path
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from affordplan import cli
 from affordplan.bench import bench_sim
-from affordplan.demo import run_demo
+from affordplan.errors import InputError, MeshError
+from affordplan.scene_file import DEMO_SCENE, demo_scene, load_scene, parse_scene
+from affordplan.video import write_video
+
+SCENES = Path(__file__).parents[1] / "examples" / "scenes"
 
 
-def test_demo_executes_three_primitives_and_saves_a_picture(tmp_path):
+# ----------------------------------------------------------------------------- scene files
+def test_example_json_scene_is_the_demo_scene():
+    scene = load_scene(SCENES / "mug_wall.json")
+    assert scene == demo_scene()
+    assert scene.name == "mug_wall" and scene.object == "mug"
+    assert scene.start == {"resting_state": 0, "xy": (0.45, -0.05), "yaw": 0.5}
+    assert scene.goal.resting_state == 1 and scene.goal.yaw == pytest.approx(math.pi / 2)
+    assert [b.center for b in scene.obstacles] == [(0.6, -0.21), (0.6, 0.21)]
+
+
+def test_yaml_scenes_parse_with_degrees_and_tolerances():
+    corridor = load_scene(SCENES / "box_corridor.yaml")
+    assert corridor.object == "lunch_box"
+    assert corridor.goal.yaw == pytest.approx(math.pi) and corridor.goal.yaw_tol == pytest.approx(math.radians(15))
+    assert corridor.start["yaw"] == 0.0 and len(corridor.obstacles) == 2
+    die = load_scene(SCENES / "die_two_blocks.yaml")
+    assert die.goal.resting_state == 2 and die.goal.yaw == pytest.approx(math.radians(30))
+    # a scene survives a round trip through its plain-data form
+    assert parse_scene(json.loads(json.dumps(die.as_dict()))) == die
+
+
+def _mutated(path: tuple, value):
+    data = copy.deepcopy(DEMO_SCENE)
+    d = data
+    for key in path[:-1]:
+        d = d[key]
+    if value is _DELETE:
+        del d[path[-1]]
+    else:
+        d[path[-1]] = value
+    return data
+
+
+_DELETE = object()
+
+
+@pytest.mark.parametrize("path, value, error, words", [
+    (("goal", "xy"), [0.69], InputError, "goal.xy must be a list of 2 numbers"),
+    (("goal", "xy"), [0.69, "a"], InputError, "goal.xy[1] must be a finite number"),
+    (("goal", "xy_tol"), 0.0, InputError, "goal.xy_tol must be positive"),
+    (("goal", "yaw"), 1.0, InputError, "give yaw (radians) or yaw_deg (degrees), not both"),
+    (("goal", "resting_state"), -1, InputError, "goal.resting_state must be a resting-state index"),
+    (("goal", "colour"), "red", InputError, "goal: unknown field(s) ['colour']"),
+    (("start", "xy"), _DELETE, InputError, "start: missing field 'xy'"),
+    (("start", "resting_state"), 1.5, InputError, "start.resting_state must be a resting-state index"),
+    (("obstacles",), {"center": [0.6, 0.0]}, InputError, "obstacles must be a list"),
+    (("obstacles", 1, "size"), [0.02, -0.2, 0.1], InputError, "obstacles[1].size must be positive"),
+    (("obstacles", 0, "centre"), [0.6, 0.0], InputError, "obstacles[0]: unknown field(s) ['centre']"),
+    (("goal",), _DELETE, InputError, "missing field 'goal'"),
+    (("object",), 3, InputError, "object must be a catalogue name or a mesh path"),
+    (("obstacle",), [], InputError, "unknown field(s) ['obstacle']"),
+])
+def test_bad_scene_fields_are_named(path, value, error, words):
+    with pytest.raises(error) as info:
+        parse_scene(_mutated(path, value), source="s.json")
+    assert str(info.value).startswith("s.json: ") and words in str(info.value)
+
+
+def test_resting_states_are_checked_against_the_object():
+    scene = parse_scene(_mutated(("goal", "resting_state"), 7), source="s.json")
+    with pytest.raises(InputError, match=r"s.json: goal.resting_state: mug has 3 resting states"):
+        scene.load_object()
+    with pytest.raises(MeshError, match="s.json: object: unknown object 'teapot'"):
+        parse_scene(_mutated(("object",), "teapot"), source="s.json").load_object()
+
+
+def test_scene_files_on_disk(tmp_path):
+    with pytest.raises(InputError, match="does not exist"):
+        load_scene(tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{\"object\": \"mug\",")
+    with pytest.raises(InputError, match="bad.json: not valid JSON"):
+        load_scene(bad)
+    yml = tmp_path / "bad.yaml"
+    yml.write_text("object: [mug\n")
+    with pytest.raises(InputError, match="bad.yaml: not valid YAML"):
+        load_scene(yml)
+    txt = tmp_path / "scene.txt"
+    txt.write_text("{}")
+    with pytest.raises(InputError, match="must end in .json, .yaml or .yml"):
+        load_scene(txt)
+    # a relative mesh path is resolved against the scene file's folder; the name defaults to the stem
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "part.stl").write_text("solid part\nendsolid part\n")
+    data = _mutated(("object",), "meshes/part.stl")
+    del data["name"]
+    (tmp_path / "part_scene.json").write_text(json.dumps(data))
+    scene = load_scene(tmp_path / "part_scene.json")
+    assert Path(scene.object) == tmp_path / "meshes" / "part.stl" and scene.name == "part_scene"
+
+
+# ------------------------------------------------------------------------------------ help
+SUBCOMMANDS = [["demo"], ["plan"], ["render"], ["affordances"], ["bench"], ["bench", "sim"],
+               ["bench", "sim2sim"], ["bench", "plan"]]
+
+
+def test_cli_help_has_examples(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["--help"])
+    out = capsys.readouterr().out
+    assert "examples:" in out
+    assert all(name in out for name in ("demo", "plan", "render", "affordances", "bench"))
+
+
+@pytest.mark.parametrize("argv", SUBCOMMANDS, ids=" ".join)
+def test_every_subcommand_help_shows_an_example(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv + ["--help"])
+    assert info.value.code == 0
+    out = capsys.readouterr().out
+    assert "example" in out and f"affordplan {' '.join(argv)}" in out
+
+
+def test_bench_registers_robustness_when_it_exists(monkeypatch, capsys):
+    module = types.ModuleType("affordplan.robustness")
+
+    def register_cli(bench_sub):
+        p = bench_sub.add_parser("robustness", help="fake", epilog="example:\n  affordplan bench robustness")
+        p.set_defaults(func=lambda args: print("robustness ran") or 0)
+
+    module.register_cli = register_cli
+    monkeypatch.setitem(sys.modules, "affordplan.robustness", module)
+    monkeypatch.setattr("affordplan.robustness", module, raising=False)
+    assert cli.main(["bench", "robustness"]) == 0
+    assert "robustness ran" in capsys.readouterr().out
+
+
+# ---------------------------------------------------------------------------------- errors
+def test_cli_reports_library_errors_cleanly(capsys, tmp_path):
+    assert cli.main(["render", "teapot"]) == 2
+    assert "unknown object 'teapot'" in capsys.readouterr().err
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps(_mutated(("obstacles", 0, "size"), [0.02, 0.2])))
+    assert cli.main(["plan", str(scene), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("affordplan: error: ") and "obstacles[0].size must be a list of 3 numbers" in err
+    assert not (tmp_path / "out").exists()
+
+
+# ------------------------------------------------------------------------- render, video
+def test_render_writes_one_tile_per_state(tmp_path, capsys):
+    out = tmp_path / "cube.png"
+    assert cli.main(["render", "cube", "--state", "0", "2", "--width", "64", "--height", "48",
+                     "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "cube: 6 resting states" in text and f"wrote {out}" in text
+    image = np.asarray(Image.open(out).convert("RGB"))
+    assert image.shape == (48, 128, 3)
+    assert image[20:, :64].std() > 5 and image[20:, 64:].std() > 5  # rendered scenes, not blank tiles
+    assert cli.main(["render", "cube", "--state", "6", "--width", "64", "--height", "48"]) == 2
+    assert "cube has 6 resting states (0..5), got state 6" in capsys.readouterr().err
+
+
+def _frames(n=5, h=36, w=48):
+    rng = np.random.default_rng(0)
+    return [rng.integers(0, 255, (h, w, 3), dtype=np.uint8) for _ in range(n)]
+
+
+def test_write_video_mp4_and_gif(tmp_path):
+    import imageio.v2 as imageio
+
+    mp4 = write_video(_frames(), tmp_path / "v.mp4", fps=5)
+    assert mp4.suffix == ".mp4" and len(imageio.mimread(mp4)) == 5
+    gif = write_video(_frames(4), tmp_path / "v.gif", fps=5)
+    assert Image.open(gif).n_frames == 4
+    with pytest.raises(InputError, match="no frames"):
+        write_video([], tmp_path / "x.mp4")
+
+
+def test_write_video_falls_back_to_gif_without_ffmpeg(tmp_path, monkeypatch):
+    def no_ffmpeg(*args, **kwargs):
+        raise ImportError("no module named imageio_ffmpeg")
+
+    monkeypatch.setattr("affordplan.video._write_mp4", no_ffmpeg)
+    with pytest.warns(UserWarning, match="writing a GIF instead"):
+        path = write_video(_frames(3), tmp_path / "v.mp4", fps=5)
+    assert path == tmp_path / "v.gif" and Image.open(path).n_frames == 3
+
+
+def test_viewer_without_a_display_carries_on_headless(monkeypatch):
+    from affordplan.viewer import open_viewer
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
     lines: list[str] = []
-    rows = run_demo(tmp_path, echo=lines.append)
-    assert [r["primitive"] for r in rows] == ["push", "roll", "spin"]
-    assert all(r["valid"] and r["approach_ok"] for r in rows)
-    push = rows[0]
-    assert push["moved_cm"] > 4.0 and push["turned_deg"] < 5.0
-    assert (tmp_path / "demo.png").stat().st_size > 10_000
-    assert any("seed losses" in line for line in lines)
+    assert open_viewer(object(), echo=lines.append) is None
+    assert "no display" in lines[0] and "headless" in lines[0]
 
 
+# ------------------------------------------------------------------------------------ demo
+def test_demo_one_primitive_in_the_arm_sim_writes_every_output(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    out = tmp_path / "demo"
+    argv = ["demo", "--max-primitives", "1", "--out", str(out), "--width", "96", "--height", "72",
+            "--frame-interval", "0.2", "--viewer", "-q"]
+    assert cli.main(argv) == 0
+    text = capsys.readouterr().out
+    assert "plan:" in text and "roll target=state 1" in text  # the plan starts by flipping the mug upright
+    assert "no display" in text  # --viewer without a display: said, and carried on
+    assert "outcome: goal" in text and "position error" in text and "yaw error" in text and "resting state" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["execution"]["n_primitives"] == 1 and summary["plan"]["route"] == [0, 1]
+    assert summary["files"] == {"plan": "plan.png", "frames": "frames.png", "video": "video.mp4",
+                                "summary": "summary.json"}
+    assert Image.open(out / "plan.png").size[0] > 300 and Image.open(out / "frames.png").size[0] > 96
+    import imageio.v2 as imageio
+
+    frames = imageio.mimread(out / "video.mp4")
+    assert len(frames) >= 3 and frames[0].shape == (72, 96, 3)
+
+
+def test_a_finished_run_exits_0_and_check_makes_a_missed_goal_exit_1(monkeypatch):
+    seen = []
+
+    def fake_run_demo(out, **kwargs):
+        seen.append(kwargs)
+        return types.SimpleNamespace(success=False)
+
+    monkeypatch.setattr("affordplan.demo.run_demo", fake_run_demo)
+    assert cli.main(["demo"]) == 0
+    assert cli.main(["demo", "--check", "--sim", "finger", "--no-video"]) == 1
+    assert seen[0]["sim"] == "arm" and seen[0]["max_primitives"] == 30 and seen[0]["video"]
+    assert seen[1]["sim"] == "finger" and not seen[1]["video"]
+
+
+# ----------------------------------------------------------------------------------- bench
 def test_bench_sim_counts_steps_and_time():
     r = bench_sim("cube", n=6, progress=False)
     assert r.primitives == 6 and r.steps > 6 * 500  # each primitive simulates >= 1 s
@@ -37,17 +264,6 @@ def test_cli_bench_json(capsys):
     assert data[0]["primitives_per_s"] > 0
 
 
-def test_cli_reports_library_errors_cleanly(capsys):
-    assert cli.main(["demo", "--object", "teapot", "--no-render"]) == 2
-    assert "unknown object 'teapot'" in capsys.readouterr().err
-
-
-def test_cli_help_has_examples(capsys):
-    with pytest.raises(SystemExit):
-        cli.main(["--help"])
-    assert "examples:" in capsys.readouterr().out
-
-
 def test_bench_sim2sim_compares_identical_primitives():
     from affordplan.bench import bench_sim2sim
 
@@ -56,3 +272,4 @@ def test_bench_sim2sim_compares_identical_primitives():
     assert len(r.displacement_diff_m) == r.compared
     assert np.all(r.displacement_diff_m >= 0) and np.all(r.rotation_diff_rad >= 0)
     assert "p90" in r.report()
+

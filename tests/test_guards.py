@@ -66,3 +66,12 @@ def test_execute_reports_the_guard(cube):
     out = sim.execute(T[:3, 3] + np.array([-0.05, 0.0, 0.07]), (1.0, 0.0, 0.0))
     assert not out.valid
     assert out.invalid_reason in {"sank", "speed", "unstable"}
+
+
+def test_off_table_after_settling(guarded):
+    sim, guard = guarded
+    assert guard.check_rest() is None  # resting on the table
+    sim.data.qpos[2] += 0.05  # hanging 5 cm up (on the pusher, or on an obstacle)
+    mujoco.mj_forward(sim.model, sim.data)
+    assert guard.check_rest() == "off_table"
+    assert guard.check() is None  # mid-primitive, being lifted is not a fault by itself

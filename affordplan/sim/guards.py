@@ -8,7 +8,10 @@ marked ``valid=False``. Checks (all vectorised, no per-contact Python):
 - ``"unstable"``: MuJoCo's bad-acceleration warning fired (it resets the state when it does);
 - ``"left_workspace"``: the centre of mass is off the workspace by more than ``workspace_margin``;
 - ``"speed"``: linear or angular speed above a bound no push can cause;
-- ``"sank"``: the lowest hull vertex is deeper under the table than ``max_penetration``.
+- ``"sank"``: the lowest hull vertex is deeper under the table than ``max_penetration``;
+- ``"off_table"`` (:meth:`PhysicsGuard.check_rest`, once the object has settled): its lowest hull vertex
+  is more than ``max_rest_height`` above the table, so it hangs on the pusher or lies on an obstacle
+  (a fingertip caught in a mug's opening lifts the mug on the retract).
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ class GuardLimits:
     max_linear_speed: float = 2.0  # m/s
     max_angular_speed: float = 40.0  # rad/s
     max_penetration: float = 0.006  # metres below the table surface
+    max_rest_height: float = 0.01  # metres: lowest point above the table once settled
 
 
 class PhysicsGuard:
@@ -65,8 +69,17 @@ class PhysicsGuard:
         if (np.linalg.norm(qvel[:3]) > self.limits.max_linear_speed
                 or np.linalg.norm(qvel[3:]) > self.limits.max_angular_speed):
             return "speed"
-        R = d.xmat[self._body].reshape(3, 3)
-        lowest = float(np.min(self._hull @ R[2]) + d.xpos[self._body, 2])
-        if lowest < -self.limits.max_penetration:
+        if self.lowest_point() < -self.limits.max_penetration:
             return "sank"
+        return None
+
+    def lowest_point(self) -> float:
+        """Height of the object's lowest hull vertex above the table, metres (world z)."""
+        R = self._data.xmat[self._body].reshape(3, 3)
+        return float(np.min(self._hull @ R[2]) + self._data.xpos[self._body, 2])
+
+    def check_rest(self) -> str | None:
+        """After settling: ``"off_table"`` when the object does not rest on the table, else ``None``."""
+        if self.lowest_point() > self.limits.max_rest_height:
+            return "off_table"
         return None

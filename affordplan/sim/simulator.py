@@ -4,7 +4,7 @@ A primitive follows HACMan's protocol (DESIGN.md): the fingertip is brought 4 cm
 contact's outward normal (the finger teleports there; the arm transits at a safe height above the
 obstacles and the object, then descends), servoes to 2 cm, then to the contact (the tip's surface touching it); the
 motion is 3 control steps that each move the target by ``motion * 3 cm`` over 0.5 s; the finger
-retracts 5 cm upwards and leaves (the arm rises to the safe height), and the object settles (until
+backs off 2 cm along the normal, rises 5 cm and leaves (the arm rises to the safe height), and the object settles (until
 still, at most 2 s).
 
 Physics runs in chunks of ``CHUNK_STEPS`` steps through ``mj_step(..., nstep)``; the pusher target is
@@ -255,8 +255,11 @@ class Simulator:
                     nxt = self._clamp(target + p.motion_step * motion)
                     self._servo(target, nxt, p.motion_step_time, track=True)
                     target = nxt
-            self._retract()
+            self._retract(normal)
             self._settle(p.settle_time_max)
+            reason = self._guard.check_rest()
+            if reason is not None:
+                raise _Abort(reason)
         except _Abort as abort:
             result.update(valid=False, invalid_reason=str(abort))
             self._pusher.home()
@@ -288,9 +291,13 @@ class Simulator:
             and turned <= p.approach_disturbance_angle
         )
 
-    def _retract(self) -> None:
+    def _retract(self, normal: np.ndarray) -> None:
+        """Back off along the contact normal, then rise (rising straight from inside a cavity lifts the object)."""
+        p = self.protocol
         start = self._pusher.target()
-        self._servo(start, start + np.array([0.0, 0.0, self.protocol.retract_height]), self.protocol.retract_time)
+        back = self._clamp(start + p.mid_standoff * normal)
+        self._servo(start, back, p.retract_time)
+        self._servo(back, back + np.array([0.0, 0.0, p.retract_height]), p.retract_time)
         self._pusher.leave(self._servo)
 
     def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False) -> None:
