@@ -11,7 +11,9 @@ from affordplan.errors import GoalError, InputError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
 from affordplan.world import Box, Workspace
-from planner.plan import Plan, Planner
+from planner.footprint import footprint
+from planner.motion import FootprintChecker
+from planner.plan import WORKSPACE_OVERHANG, Plan, Planner
 from planner.predict import Predictor
 
 PLANNERS = ("affordplan", "greedy")
@@ -27,17 +29,43 @@ def start_pose(obj: ObjectModel, start) -> np.ndarray:
             raise InputError(f"start takes resting_state, xy and yaw; got {sorted(unknown)}")
         state = start.get("resting_state", 0)
         n = len(obj.resting_states)
-        if not isinstance(state, (int, np.integer)) or not 0 <= state < n:
-            raise InputError(f"start resting_state must be an index in [0, {n}), got {state!r}")
+        if isinstance(state, bool) or not isinstance(state, (int, np.integer)):
+            raise InputError(f"start resting_state must be an integer index, got {state!r}")
+        if not 0 <= state < n:
+            raise GoalError(f"start resting_state {state} does not exist: {obj.name} has {n} resting states "
+                            f"(0..{n - 1})")
         xy = np.asarray(start.get("xy", Workspace().center), dtype=float)
         yaw = start.get("yaw", 0.0)
         if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not math.isfinite(yaw):
             raise InputError(f"start xy must be 2 finite numbers and yaw finite, got {start!r}")
         return obj.resting_states[int(state)].pose(xy, float(yaw))
-    T = np.asarray(start, dtype=float)
+    try:
+        T = np.asarray(start, dtype=float)
+    except (TypeError, ValueError):
+        T = np.empty(0)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise InputError("start must be a dict or a finite 4x4 pose")
+    R = T[:3, :3]
+    if not (np.allclose(R.T @ R, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0):
+        raise InputError("start pose's upper-left 3x3 block must be a rotation matrix")
     return T
+
+
+def check_start(obj: ObjectModel, T_start: np.ndarray, obstacles: Sequence[Box], workspace: Workspace) -> None:
+    """Raise :class:`GoalError` when the object at ``T_start`` overlaps an obstacle or its centre is off
+    the workspace.
+
+    The object's own footprint is checked, not the one the planner inflates for the fingertip: a
+    start closer to an obstacle than that clearance is legal (the plan then pushes it clear first).
+    """
+    state, x, y, yaw = obj.planar_pose(T_start)
+    if not workspace.contains((x, y)):
+        raise GoalError(f"the start xy=({x:.3f}, {y:.3f}) is outside the workspace {workspace}")
+    m = WORKSPACE_OVERHANG
+    grown = Workspace((workspace.x[0] - m, workspace.x[1] + m), (workspace.y[0] - m, workspace.y[1] + m))
+    why = FootprintChecker(footprint(obj, state), obstacles, grown).why_not_free(x, y, yaw)
+    if why is not None:
+        raise GoalError(f"the start pose is in collision: {why}")
 
 
 def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] = (), time_limit: float = 5.0,
@@ -47,7 +75,17 @@ def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] =
 
     ``planner="greedy"`` returns the reactive baseline: a plan without steps whose ``execute`` picks
     every call on the spot (:func:`planner.execute.execute_greedy`).
+
+    Raises:
+        GoalError: the goal is malformed, in an obstacle, off the workspace or in a resting state the
+            object does not have; or the start is in collision, off the workspace or in a resting
+            state the object does not have.
+        InputError: a malformed start (NaN, wrong shape, unknown keys), planner or time limit.
+        PlanningError: no plan within ``time_limit``; the message names why (no collision-free path,
+            no room to roll, no chain of rolls, out of time).
     """
+    if not isinstance(obj, ObjectModel):
+        raise InputError(f"obj must be an ObjectModel (see affordplan.load_object), got {type(obj).__name__}")
     if planner not in PLANNERS:
         raise InputError(f"planner must be one of {PLANNERS}, got {planner!r}")
     if not isinstance(goal, Goal):
@@ -55,13 +93,11 @@ def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] =
     if not (isinstance(time_limit, (int, float)) and math.isfinite(time_limit) and time_limit > 0):
         raise InputError(f"time_limit must be a positive number of seconds, got {time_limit!r}")
     T0 = start_pose(obj, start)
+    obstacles = tuple(obstacles)
     p = Planner(obj, obstacles, workspace, predictor=predictor, time_limit=time_limit, seed=seed)
+    check_start(obj, T0, obstacles, workspace)
     if planner == "greedy":
         p.check_goal(goal, obj.classify(T0))
         return Plan(steps=[], p_success=float("nan"), planning_time=0.0, route=[], goal=goal, start_pose=T0,
                     planner=p, kind="greedy")
-    state, x, y, yaw = obj.planar_pose(T0)
-    why = p.checkers[state].why_not_free(x, y, yaw)
-    if why is not None:
-        raise InputError(f"the start pose collides or leaves the workspace: {why}")
     return p.plan(T0, goal)

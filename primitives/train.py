@@ -36,6 +36,7 @@ import argparse
 import csv
 import json
 import resource
+import sys
 import time
 from collections import deque
 from dataclasses import asdict, dataclass
@@ -342,7 +343,11 @@ def main(argv: list[str] | None = None) -> int:
             import_ray()  # the optional dependency: fail now, saying how to install it
     except (InputError, ImportError) as exc:
         parser.error(str(exc))
-    summary = train(cfg, resume=args.resume)
+    try:
+        summary = train(cfg, resume=args.resume)
+    except ckpt.CheckpointError as exc:  # a damaged checkpoint: say which file and why, not a traceback
+        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
+        return 2
     print(json.dumps({k: v for k, v in summary.items() if k != "rss_samples"}, indent=2))
     return 0
 

@@ -6,9 +6,11 @@ or a ``trimesh.Trimesh``, and normalises it like HACMan: the object frame sits a
 longest side of its axis-aligned bounding box in the source frame) equals ``size`` metres.
 
 Real meshes are often not watertight. Such a mesh is repaired by hole filling when that makes it a
-closed volume; otherwise its convex hull stands in for the solid (mass, centre of mass, inertia and
-resting states), and a warning says so. What cannot be made physical raises
-:class:`~affordplan.errors.MeshError`.
+closed volume, and closed bodies that overlap are merged by a boolean union; otherwise its convex
+hull stands in for the solid (mass, centre of mass, inertia and resting states), and a warning says
+so. Huge meshes are decimated. What cannot be made physical (empty, unreadable, NaN or infinite
+vertices, flat, zero volume) raises :class:`~affordplan.errors.MeshError` naming the fault; see
+:mod:`affordplan.objects.repair`.
 """
 
 from __future__ import annotations
@@ -16,21 +18,19 @@ from __future__ import annotations
 import functools
 import math
 import os
-import warnings
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
 from affordplan.errors import InputError, MeshError
-from affordplan.objects import decompose, family
+from affordplan.objects import decompose, family, repair
 from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states
 from affordplan.objects.shapes import CATALOGUE, Shape
 
 DEFAULT_SIZE = 0.05  # largest half-extent, metres
 DEFAULT_DENSITY = 400.0  # kg/m^3: household objects are partly hollow
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb", ".gltf", ".off", ".dae", ".3mf")
-_MIN_RELATIVE_VOLUME = 1e-4  # hull volume / (longest extent)^3 below which a mesh is flat
 
 
 class ObjectModel:
@@ -42,7 +42,8 @@ class ObjectModel:
         parts: convex pieces whose union is the collision shape, object frame.
         mass: kilograms.
         inertia: 3x3 inertia tensor about the centre of mass, object frame, kg m^2.
-        hull: convex hull of ``mesh`` (what the object rests on).
+        hull: convex hull of ``mesh`` (what the object rests on), simplified to at most
+            ``repair.MAX_HULL_FACES`` faces.
     """
 
     def __init__(
@@ -54,7 +55,7 @@ class ObjectModel:
         self.parts = tuple(parts)
         self.mass = float(mass)
         self.inertia = np.asarray(inertia, dtype=float)
-        self.hull = mesh.convex_hull
+        self.hull = repair.bounded_hull(mesh)
         self._samples: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
     def __repr__(self) -> str:
@@ -128,69 +129,29 @@ def _from_shape(name: str, shape: Shape, size: float, density: float) -> ObjectM
 def _read_mesh(path: Path) -> trimesh.Trimesh:
     if not path.exists():
         raise MeshError(f"no such mesh file: {path}")
+    if path.is_dir():
+        raise MeshError(f"{path} is a folder, not a mesh file")
     if path.stat().st_size == 0:
         raise MeshError(f"mesh file is empty: {path}")
     try:
-        loaded = trimesh.load(str(path), force="mesh")
+        # process=False: trimesh's processing would silently drop NaN / infinite vertices;
+        # repair.clean checks and processes the raw arrays.
+        loaded = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for unreadable files
-        raise MeshError(f"cannot read mesh {path}: {type(exc).__name__}: {exc}") from exc
+        raise MeshError(f"cannot read mesh {path}: {repair.first_line(exc)}") from exc
     if not isinstance(loaded, trimesh.Trimesh):
         raise MeshError(f"{path} holds no triangle mesh (got {type(loaded).__name__})")
     return loaded
 
 
-def _clean(mesh: trimesh.Trimesh, what: str) -> trimesh.Trimesh:
-    vertices = np.asarray(mesh.vertices, dtype=float)
-    faces = np.asarray(mesh.faces)
-    if len(vertices) == 0 or len(faces) == 0:
-        raise MeshError(f"{what} is empty ({len(vertices)} vertices, {len(faces)} faces)")
-    bad = ~np.isfinite(vertices).all(axis=1)
-    if bad.any():
-        raise MeshError(f"{what} has {int(bad.sum())} vertices with NaN or infinite coordinates")
-    if faces.ndim != 2 or faces.shape[1] != 3 or faces.min() < 0 or faces.max() >= len(vertices):
-        raise MeshError(f"{what} has malformed faces")
-    mesh = trimesh.Trimesh(vertices, faces, process=True)
-    mesh.update_faces(mesh.nondegenerate_faces())
-    mesh.remove_unreferenced_vertices()
-    if len(mesh.faces) == 0:
-        raise MeshError(f"{what} has only degenerate faces")
-    return mesh
-
-
-def _solid(mesh: trimesh.Trimesh, what: str) -> tuple[trimesh.Trimesh, bool]:
-    """The closed volume standing for ``mesh``, and whether it is the mesh itself."""
-    try:
-        with np.errstate(invalid="ignore", divide="ignore"):  # flat input: 0/0 in trimesh
-            hull = mesh.convex_hull
-            hull_volume = float(hull.volume)
-    except Exception as exc:  # qhull fails on flat or collinear input
-        raise MeshError(f"{what} has zero volume (flat or degenerate): {exc}") from exc
-    longest = float(np.max(mesh.extents))
-    if longest <= 0 or not hull_volume >= _MIN_RELATIVE_VOLUME * longest**3:
-        raise MeshError(f"{what} has zero volume: it is flat or degenerate (extents {mesh.extents})")
-    if not mesh.is_watertight:
-        repaired = mesh.copy()
-        trimesh.repair.fill_holes(repaired)
-        if repaired.is_watertight:
-            mesh = repaired
-            warnings.warn(f"{what} was not watertight; holes were filled", stacklevel=3)
-    if mesh.is_watertight:
-        trimesh.repair.fix_normals(mesh)
-        if mesh.is_volume and mesh.volume > _MIN_RELATIVE_VOLUME * longest**3:
-            return mesh, True
-    warnings.warn(
-        f"{what} is not a closed volume; its convex hull stands in for the solid "
-        "(mass, centre of mass, inertia and resting states)", stacklevel=3,
-    )
-    return hull, False
-
-
 def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float, density: float, what: str) -> ObjectModel:
-    mesh = _clean(mesh, what)
-    solid, closed = _solid(mesh, what)
+    made = repair.solid(repair.clean(mesh, what), what)
     # Decompose in a normalised frame so cache keys do not depend on the source's units.
-    probe = _finish(name, mesh, solid, [], size, density)
-    parts = decompose.convex_parts(probe.mesh, volume=probe.mass / density if closed else None)
+    probe = _finish(name, made.surface, made.volume, [], size, density)
+    if made.soup:  # CoACD can take minutes on a soup, for nothing: its hull is its shape
+        parts = [probe.mesh.convex_hull]
+    else:
+        parts = decompose.convex_parts(probe.mesh, volume=probe.mass / density if made.closed else None)
     return ObjectModel(name, probe.mesh, parts, probe.mass, probe.inertia)
 
 
@@ -209,13 +170,19 @@ def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_
         density: kg/m^3, for the mass and inertia.
 
     Raises:
-        MeshError: the source is unknown, unreadable, empty, non-finite or has zero volume.
+        MeshError: the source is unknown, missing, unreadable, empty, non-finite, flat or has zero
+            volume; the message names which (see :mod:`affordplan.objects.repair`).
+        InputError: ``size`` or ``density`` is not a positive finite number.
     """
     _check_size(size, density)
     if isinstance(source, trimesh.Trimesh):
         return _from_mesh("mesh", source, size, density, "mesh")
     if isinstance(source, trimesh.Scene):
-        return _from_mesh("mesh", source.to_mesh(), size, density, "scene")
+        try:
+            mesh = source.to_mesh()
+        except Exception as exc:
+            raise MeshError(f"the scene holds no usable triangle mesh ({repair.first_line(exc)})") from exc
+        return _from_mesh("mesh", mesh, size, density, "scene")
     if isinstance(source, (str, os.PathLike)):
         text = os.fspath(source)
         if text in CATALOGUE:
