@@ -32,7 +32,10 @@ class Goal:
     yaw_tol: float = math.radians(15.0)
 
     def __post_init__(self):
-        xy = np.asarray(self.xy, dtype=float).reshape(-1)
+        try:
+            xy = np.asarray(self.xy, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise GoalError(f"goal xy must be two finite numbers (metres), got {self.xy!r}") from None
         if xy.shape != (2,) or not np.all(np.isfinite(xy)):
             raise GoalError(f"goal xy must be two finite numbers (metres), got {self.xy!r}")
         object.__setattr__(self, "xy", (float(xy[0]), float(xy[1])))

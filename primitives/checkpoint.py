@@ -21,8 +21,11 @@ class CheckpointError(AffordplanError):
 
 
 def save(path: str | Path, payload: dict) -> None:
+    """Write ``payload`` atomically to ``path``; temporary files left by a killed earlier write are removed."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    for stale in path.parent.glob(f"{path.name}*.tmp"):  # a run killed mid-write leaves one behind
+        stale.unlink(missing_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:

@@ -127,7 +127,12 @@ class RolloutSource(Protocol):
 # ---------------------------------------------------------------------------- local processes
 def _local_worker(env_config: EnvConfig, explore: Exploration, seed: int, weights_q: mp.Queue, out_q: mp.Queue,
                   stop) -> None:
-    """Process body: collect transitions with the latest weights until ``stop`` is set."""
+    """Process body: collect transitions with the latest weights until ``stop`` is set.
+
+    A learner killed with SIGKILL never sets ``stop``: the worker then notices that its parent is gone
+    (checked whenever the queue stays full for a second) and exits instead of blocking for good.
+    """
+    parent = mp.parent_process()
     collector = Collector(env_config, explore, seed, weights_q.get())
     while not stop.is_set():
         try:
@@ -135,7 +140,17 @@ def _local_worker(env_config: EnvConfig, explore: Exploration, seed: int, weight
                 collector.load_weights(weights_q.get_nowait())
         except queue.Empty:
             pass
-        out_q.put(collector.step())
+        transition = collector.step()
+        while not stop.is_set():
+            try:
+                out_q.put(transition, timeout=1.0)
+                break
+            except queue.Full:
+                if parent is not None and not parent.is_alive():
+                    collector.close()
+                    return
+        if parent is not None and not parent.is_alive():
+            break
     collector.close()
 
 

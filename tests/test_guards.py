@@ -75,3 +75,12 @@ def test_off_table_after_settling(guarded):
     mujoco.mj_forward(sim.model, sim.data)
     assert guard.check_rest() == "off_table"
     assert guard.check() is None  # mid-primitive, being lifted is not a fault by itself
+
+
+def test_a_faulty_start_is_never_a_valid_sample(cube):
+    sim = ap.Simulator(cube)
+    T = sim.reset()
+    sim.data.qpos[2] -= 0.03  # sunk 3 cm into the table before the primitive starts
+    mujoco.mj_forward(sim.model, sim.data)
+    out = sim.execute(T[:3, 3] - np.array([0.05, 0.0, 0.0]), (1.0, 0.0, 0.0))
+    assert not out.valid and out.invalid_reason == "sank"

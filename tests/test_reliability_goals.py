@@ -62,6 +62,7 @@ def test_goal_outside_the_workspace(cube, xy):
 
 @pytest.mark.parametrize("kwargs", [
     dict(xy=(math.nan, 0.0)), dict(xy=(0.5, math.inf)), dict(xy=(0.5,)), dict(xy=(0.5, 0.0, 0.0)),
+    dict(xy="here"), dict(xy=None),
     dict(xy=(0.5, 0.0), yaw=math.nan), dict(xy=(0.5, 0.0), xy_tol=math.nan), dict(xy=(0.5, 0.0), yaw_tol=-1.0),
 ])
 def test_nan_or_malformed_goal(kwargs):

@@ -248,6 +248,9 @@ class Simulator:
         self._collisions.clear()
         self._tracking.clear()
         try:
+            reason = self._guard.check()  # a start already faulty (sunk, thrown) is never a valid sample
+            if reason is not None:
+                raise _Abort(reason)
             result["approach_ok"] = self._approach(pre, touch, normal, pose_before)
             if result["approach_ok"]:
                 target = touch
