@@ -113,7 +113,7 @@ class SceneRun:
         wall_time: seconds, from loading the object to the last file written.
         off_table: ``(primitive number from 1, lowest point of the object above the table in metres)``
             after each primitive that left the object off the table (lifted by the pusher, or lying on an
-            obstacle): a physics fault the simulator's guards do not flag, reported rather than hidden.
+            obstacle): the off_table guard then stops execution; reported rather than hidden.
     """
 
     scene: Scene
@@ -292,7 +292,7 @@ def outcome_lines(run: SceneRun, obj: ObjectModel) -> list[str]:
         top = max(h for _, h in run.off_table)
         lines.append(f"  warning: after primitive {first} the {obj.name} was off the table, {100 * height:.0f} cm up "
                      f"(at most {100 * top:.0f} cm; off the table after {len(run.off_table)} primitives in all): "
-                     "lifted by the pusher or left on an obstacle, which the physics guards do not flag")
+                     "lifted by the pusher or left on an obstacle (the off_table guard)")
     return lines
 
 
