@@ -143,7 +143,17 @@ def compute_resting_states(
             dict(rotation=R, height=height, probability=float(probs[members].sum()), up=up,
                  heading=heading, member_ups=member_ups, roll_axis=roll_axis)
         )
-    states.sort(key=lambda s: -s["probability"])
+    # Most likely first. Ties (a cube's six faces; a box's opposite faces) are broken by the up-vector, so that
+    # the order does not hang on the last bits of trimesh's probabilities (which differ between its releases).
+    # Tied states get one probability (the mean of the tie), so that the list stays sorted exactly.
+    states.sort(key=lambda s: (-round(s["probability"], 4), *(-np.round(s["up"][::-1], 3))))
+    ties: dict[float, list[dict]] = {}
+    for s in states:
+        ties.setdefault(round(s["probability"], 4), []).append(s)
+    for tie in ties.values():
+        mean = float(np.mean([s["probability"] for s in tie]))
+        for s in tie:
+            s["probability"] = mean
     states = [s for s in states if s["probability"] >= min_probability] or states[:1]
     total = sum(s["probability"] for s in states)
     return [
