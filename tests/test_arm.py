@@ -79,3 +79,23 @@ def test_arm_determinism(cube):
         sim = ap.Simulator(cube, pusher="arm")
         poses.append(face_push(sim, xy=(0.55, 0.1), stroke=0.8).pose_after)
     assert np.array_equal(poses[0], poses[1])
+
+
+def test_a_contact_under_the_mugs_handle_fails_its_approach_without_lifting_the_mug():
+    """The pre-contact point lies under the lying mug's handle: coming down onto it would hook the handle.
+
+    Before the arm checked its way down, this very call (a roll the learned policy chose in the demo)
+    carried the mug 17 cm up on the fingertip and the ``off_table`` guard ended the run.
+    """
+    mug = ap.load_object("mug")
+    sim = ap.Simulator(mug, pusher="arm", seed=0)
+    T0 = sim.reset(resting_state=0, xy=(0.45, -0.05), yaw=0.5)
+    contact = np.array([0.42040747, -0.05431026, 0.05077498])
+    normal = sim.surface_normal(contact)
+    pre = contact + (sim._pusher.radius + sim.protocol.standoff) * normal
+    assert not sim._pusher.can_descend_to(pre)
+    assert sim._pusher.can_descend_to(np.array([0.6, 0.2, 0.03]))  # open table
+    out = sim.execute(contact, (-0.76, -0.69, 0.01))
+    assert out.valid and not out.approach_ok
+    assert np.linalg.norm(out.pose_after[:3, 3] - T0[:3, 3]) < 0.005  # untouched: still where it was
+    assert mug.classify(out.pose_after) == 0

@@ -6,6 +6,7 @@ the primitive protocol and the physics loop:
 - ``home()``: put the pusher out of the way, at rest (no physics);
 - ``go_to(pos, servo)``: bring the fingertip to ``pos`` before an approach (the finger teleports;
   the arm transits at a safe height, using ``servo`` to run physics);
+- ``can_descend_to(pos)``: whether nothing blocks the way down to ``pos`` (always true for the finger);
 - ``command(target)``: set the fingertip target for the next control chunk;
 - ``leave(servo)``: get clear of the object after a primitive;
 - ``tip()``, ``tilt()``: fingertip position (world, metres) and its angle from pointing down (rad).
@@ -49,6 +50,9 @@ class FingerPusher:
 
     def go_to(self, pos: np.ndarray, servo: Servo) -> None:
         self._teleport(pos)
+
+    def can_descend_to(self, pos: np.ndarray) -> bool:
+        return True  # the finger teleports to the pre-contact point
 
     def command(self, target: np.ndarray) -> None:
         self.data.ctrl[self._ctrl] = target
@@ -95,6 +99,7 @@ class ArmPusher:
         self._target = np.zeros(3)
         bodies = {model.body(n).id for n in arm.ARM_BODIES}
         self.geoms = np.array([g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in bodies])
+        self._own_geoms = frozenset(int(g) for g in self.geoms)
 
     @property
     def q(self) -> np.ndarray:
@@ -119,6 +124,28 @@ class ArmPusher:
             dist = float(np.linalg.norm(b - a))
             if dist > 1e-4:
                 servo(a, b, max(dist / self.transit_speed, self._chunk_time))
+
+    def can_descend_to(self, pos: np.ndarray) -> bool:
+        """Whether the fingertip can come straight down to ``pos`` (world, metres) from the safe height.
+
+        Five vertical rays (the axis and four at 0.9 of the tip radius) are cast from the safe height;
+        anything but the arm itself met above the tip's lowest point at ``pos`` blocks the way (a mug's
+        handle over the pre-contact point: descending through it hooks the mug and lifts it off).
+        """
+        top = max(self._safe_height(), float(pos[2])) + 0.01
+        floor = float(pos[2]) - self.radius
+        down = np.array([0.0, 0.0, -1.0])
+        hit = np.zeros(1, dtype=np.int32)
+        for dx, dy in ((0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)):
+            start = np.array([pos[0] + 0.9 * self.radius * dx, pos[1] + 0.9 * self.radius * dy, top])
+            while True:  # skip the arm's own geoms (it may hang above the spot)
+                dist = mujoco.mj_ray(self.model, self.data, start, down, None, 1, -1, hit)
+                if dist < 0 or start[2] - dist <= floor:
+                    break
+                if int(hit[0]) not in self._own_geoms:
+                    return False
+                start = start + (dist + 1e-4) * down
+        return True
 
     def command(self, target: np.ndarray) -> None:
         self._target = np.asarray(target, dtype=float).copy()

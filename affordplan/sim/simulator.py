@@ -251,14 +251,17 @@ class Simulator:
             reason = self._guard.check()  # a start already faulty (sunk, thrown) is never a valid sample
             if reason is not None:
                 raise _Abort(reason)
-            result["approach_ok"] = self._approach(pre, touch, normal, pose_before)
-            if result["approach_ok"]:
-                target = touch
-                for _ in range(p.motion_steps):
-                    nxt = self._clamp(target + p.motion_step * motion)
-                    self._servo(target, nxt, p.motion_step_time, track=True)
-                    target = nxt
-            self._retract(normal)
+            # The arm comes down onto the pre-contact point from above: when something is in the way (a
+            # handle over it), the approach fails without touching anything.
+            if self._pusher.can_descend_to(pre):
+                result["approach_ok"] = self._approach(pre, touch, normal, pose_before)
+                if result["approach_ok"]:
+                    target = touch
+                    for _ in range(p.motion_steps):
+                        nxt = self._clamp(target + p.motion_step * motion)
+                        self._servo(target, nxt, p.motion_step_time, track=True)
+                        target = nxt
+                self._retract(normal)
             self._settle(p.settle_time_max)
             reason = self._guard.check_rest()
             if reason is not None:
