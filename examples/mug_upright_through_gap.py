@@ -3,6 +3,7 @@
     python examples/mug_upright_through_gap.py [--sim arm|finger] [--out DIR]
 """
 
+import math
 import sys
 
 import numpy as np
@@ -17,5 +18,5 @@ if __name__ == "__main__":
     lying = mug.resting_states[0].index if upright != 0 else 1
     wall = [ap.Box(center=(0.6, -0.21), size=(0.02, 0.2, 0.1)), ap.Box(center=(0.6, 0.21), size=(0.02, 0.2, 0.1))]
     goal = ap.Goal(xy=(0.69, 0.0), resting_state=upright)
-    start = {"resting_state": lying, "xy": (0.45, -0.05), "yaw": 0.5}
+    start = {"resting_state": lying, "xy": (0.45, -0.05), "yaw": math.radians(-150.0)}
     sys.exit(run_example("mug_upright_through_gap", mug, goal, start, wall, __doc__))
