@@ -242,17 +242,20 @@ class Planner:
         r = max(self.radius[a], self.radius[b]) + self.roll_margin
         disc = r * np.stack([np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
                              np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False))], axis=1)
-        checker = FootprintChecker(disc, self.obstacles, self.workspace)
+        # The disc must keep clear of obstacles; the object itself (its own footprint) must lie in the workspace,
+        # but the room a roll needs may reach over the workspace's edge (nothing stands there).
+        ws = self.workspace
+        grown = Workspace(x=(ws.x[0] - r, ws.x[1] + r), y=(ws.y[0] - r, ws.y[1] + r))
+        checker = FootprintChecker(disc, self.obstacles, grown)
         if checker.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur):
             return float(cur[0]), float(cur[1])
-        ws = self.workspace
         xs = np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01)
         ys = np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01)
         best, best_cost = None, math.inf
         for px in xs:
             for py in ys:
                 cost = math.hypot(px - cur[0], py - cur[1]) + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1])
-                if cost < best_cost and checker.is_free(px, py, 0.0):
+                if cost < best_cost and checker.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]):
                     best, best_cost = (float(px), float(py)), cost
         if best is None:
             raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")

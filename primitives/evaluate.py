@@ -55,10 +55,16 @@ def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActo
     return model
 
 
-def greedy_action(model: HybridActorCritic, obs: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
-    """Deterministic action: ``(contact index, motion, critic map)``."""
+def greedy_action(model: HybridActorCritic, obs: np.ndarray,
+                  allowed: np.ndarray | None = None) -> tuple[int, np.ndarray, np.ndarray]:
+    """Deterministic action: ``(contact index, motion, critic map)``.
+
+    ``allowed``: an optional boolean mask over the points; the contact is the best allowed one.
+    """
     actions, q = model.maps(torch.from_numpy(obs)[None])
-    idx = int(q[0].argmax())
+    scores = q[0] if allowed is None else torch.where(torch.from_numpy(np.asarray(allowed, dtype=bool)), q[0],
+                                                      torch.tensor(-torch.inf))
+    idx = int(scores.argmax())
     return idx, actions[0, idx].numpy().astype(np.float64), q[0].numpy()
 
 

@@ -19,13 +19,16 @@ import os
 import numpy as np
 import torch
 
-from affordplan.errors import InputError
+from affordplan.errors import InputError, ReachabilityError
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.env import PRIMITIVES, SkillObservation, skill_observation
 from primitives.evaluate import greedy_action, load_policy
 from primitives.networks import HybridActorCritic
 from primitives.success import SuccessModel, load_success_net
+
+MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
+UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
 
 
 class Skill:
@@ -54,11 +57,29 @@ class Skill:
         return contact, motion
 
     def execute(self, sim: Simulator, params=None) -> Outcome:
-        """Act and execute; ``Outcome.success``: the criterion for ``params`` was met (and the sample valid)."""
-        contact, normal, motion, params = self._decide(sim, params)
-        out = sim.execute(contact, motion, normal=normal)
-        out.success = bool(out.valid and rewards.success(self.name, out.pose_before, out.pose_after, params, sim.obj))
-        return out
+        """Act and execute; ``Outcome.success``: the criterion for ``params`` was met (and the sample valid).
+
+        With the arm, a contact it cannot reach (:class:`ReachabilityError`, raised before any physics)
+        is masked out together with the points within ``UNREACHABLE_RADIUS`` of it, and the policy's next
+        best contact is tried, up to ``MAX_REACH_RETRIES`` times; then the last error is raised. Without
+        this, a planner asking for the same push again meets the same unreachable contact every time.
+        """
+        seen = self.observe(sim, params)
+        allowed = np.ones(len(seen.points), dtype=bool)
+        for attempt in range(MAX_REACH_RETRIES + 1):
+            idx, motion, _ = greedy_action(self.model, seen.obs, allowed)
+            contact, normal = seen.points[idx], seen.normals[idx]
+            try:
+                out = sim.execute(contact, seen.motion_to_world(motion), normal=normal)
+            except ReachabilityError:
+                allowed &= np.linalg.norm(seen.points - contact, axis=1) > UNREACHABLE_RADIUS
+                if attempt == MAX_REACH_RETRIES or not allowed.any():
+                    raise
+                continue
+            out.success = bool(out.valid and rewards.success(self.name, out.pose_before, out.pose_after,
+                                                             seen.params, sim.obj))
+            return out
+        raise AssertionError("unreachable")  # the loop returns or raises
 
     @property
     def success_model(self) -> SuccessModel:
