@@ -121,9 +121,16 @@ TERMINAL_FAULTS = ("off_table", "left_workspace", "nan", "unstable")
 
 
 def _terminal(out) -> str | None:
-    """Why execution must stop after ``out`` (a terminal guard fault), or ``None``."""
+    """Why execution must stop after ``out`` (a terminal guard fault), or ``None``.
+
+    A primitive refused before any physics (``n_steps == 0``) because a guard flags the object's resting
+    pose (it settled over 6 mm into the table, say) would be refused again and again: that ends the run too.
+    """
     if out.invalid_reason in TERMINAL_FAULTS:
         return f"the object can no longer be manipulated: the {out.invalid_reason!r} guard fired"
+    if not out.valid and out.n_steps == 0:
+        return (f"the object can no longer be manipulated: the {out.invalid_reason!r} guard flags its pose "
+                f"before any motion")
     return None
 
 

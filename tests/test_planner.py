@@ -194,3 +194,18 @@ def test_bench_tasks_have_free_starts_and_goals():
         s = task.start["resting_state"]
         assert checkers[s].is_free(*task.start["xy"], task.start["yaw"])
         assert task.goal.resting_state is not None and 0 <= task.goal.resting_state < len(obj.resting_states)
+
+
+def test_a_primitive_refused_before_any_physics_ends_the_execution():
+    """A guard that flags the resting pose itself would refuse every later primitive: stop, do not loop."""
+    from types import SimpleNamespace
+
+    from planner.execute import _terminal
+
+    refused = SimpleNamespace(valid=False, invalid_reason="sank", n_steps=0)
+    pressed = SimpleNamespace(valid=False, invalid_reason="sank", n_steps=700)  # pressed in during a push
+    carried = SimpleNamespace(valid=False, invalid_reason="off_table", n_steps=900)
+    assert "before any motion" in _terminal(refused)
+    assert _terminal(pressed) is None
+    assert "off_table" in _terminal(carried)
+    assert _terminal(SimpleNamespace(valid=True, invalid_reason=None, n_steps=0)) is None
