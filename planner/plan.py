@@ -238,27 +238,33 @@ class Planner:
         raise PlanningError(f"the object is stuck at {tuple(np.round(cur[:2], 3))}: no free position nearby")
 
     def _roll_spot(self, a: int, b: int, cur, goal: Goal) -> tuple[float, float]:
-        """Nearest place where a roll from state ``a`` to ``b`` has room."""
+        """Nearest place where a roll from state ``a`` to ``b`` has room.
+
+        The room is a disc around the object, clear of obstacles. A disc inside the workspace is preferred
+        (rolls near its edge drift out of it); where no such spot exists (a big object among obstacles),
+        the disc may reach over the edge while the object's own footprint stays inside.
+        """
         r = max(self.radius[a], self.radius[b]) + self.roll_margin
         disc = r * np.stack([np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
                              np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False))], axis=1)
-        # The disc must keep clear of obstacles; the object itself (its own footprint) must lie in the workspace,
-        # but the room a roll needs may reach over the workspace's edge (nothing stands there).
         ws = self.workspace
         grown = Workspace(x=(ws.x[0] - r, ws.x[1] + r), y=(ws.y[0] - r, ws.y[1] + r))
-        checker = FootprintChecker(disc, self.obstacles, grown)
-        if checker.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur):
+        for room in (FootprintChecker(disc, self.obstacles, ws), FootprintChecker(disc, self.obstacles, grown)):
+            spot = self._nearest_room(room, a, cur, goal)
+            if spot is not None:
+                return spot
+        raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
+
+    def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal) -> tuple[float, float] | None:
+        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur):
             return float(cur[0]), float(cur[1])
-        xs = np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01)
-        ys = np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01)
+        ws = self.workspace
         best, best_cost = None, math.inf
-        for px in xs:
-            for py in ys:
+        for px in np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01):
+            for py in np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01):
                 cost = math.hypot(px - cur[0], py - cur[1]) + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1])
-                if cost < best_cost and checker.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]):
+                if cost < best_cost and room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]):
                     best, best_cost = (float(px), float(py)), cost
-        if best is None:
-            raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
         return best
 
 
