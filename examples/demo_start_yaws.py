@@ -1,0 +1,30 @@
+"""The demo's task from several start yaws: how often the shipped skills reach its goal in the arm sim.
+
+    python examples/demo_start_yaws.py                 # the nine yaws the README quotes
+    python examples/demo_start_yaws.py -150 0 90       # yaws of your own, degrees
+"""
+
+import math
+import sys
+
+import affordplan as ap
+from affordplan.scene_file import demo_scene
+
+YAWS_DEG = (29.0, -150.0, -105.0, -60.0, -15.0, 30.0, 75.0, 120.0, 165.0)
+
+if __name__ == "__main__":
+    scene = demo_scene()
+    obj = ap.load_object(scene.object)
+    yaws = [float(a) for a in sys.argv[1:]] or YAWS_DEG
+    reached = 0
+    for yaw_deg in yaws:
+        start = dict(scene.start, yaw=math.radians(yaw_deg))
+        try:
+            plan = ap.plan(obj, scene.goal, start=start, obstacles=scene.obstacles)
+            ex = plan.execute(sim="arm", max_primitives=30)
+            ok, detail = ex.success, f"{ex.n_primitives} primitives: {ex.reason}"
+        except ap.errors.AffordplanError as exc:
+            ok, detail = False, f"no plan: {exc}"
+        reached += ok
+        print(f"start yaw {yaw_deg:+6.0f} deg: {'REACHED' if ok else 'not reached'} ({detail})", flush=True)
+    print(f"reached the goal from {reached} of {len(yaws)} start yaws")
