@@ -46,14 +46,15 @@ class Skill:
         """Cloud, the policy's observation, the checked params and the goal frame (raises InputError)."""
         return skill_observation(sim, self.name, params, self.n_points)
 
-    def _decide(self, sim: Simulator, params) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict | None]:
-        seen = self.observe(sim, params)
-        idx, motion, _ = greedy_action(self.model, seen.obs)
-        return seen.points[idx], seen.normals[idx], seen.motion_to_world(motion), seen.params
+    def _decide(self, seen: SkillObservation,
+                allowed: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The greedy contact (world), its normal and the world-frame motion, among ``allowed`` points."""
+        idx, motion, _ = greedy_action(self.model, seen.obs, allowed)
+        return seen.points[idx], seen.normals[idx], seen.motion_to_world(motion)
 
     def act(self, sim: Simulator, params=None) -> tuple[np.ndarray, np.ndarray]:
         """The contact point (world, metres) and world-frame motion in [-1, 1]^3 the policy picks."""
-        contact, _, motion, _ = self._decide(sim, params)
+        contact, _, motion = self._decide(self.observe(sim, params))
         return contact, motion
 
     def execute(self, sim: Simulator, params=None) -> Outcome:
@@ -66,20 +67,20 @@ class Skill:
         """
         seen = self.observe(sim, params)
         allowed = np.ones(len(seen.points), dtype=bool)
-        for attempt in range(MAX_REACH_RETRIES + 1):
-            idx, motion, _ = greedy_action(self.model, seen.obs, allowed)
-            contact, normal = seen.points[idx], seen.normals[idx]
+        retries = 0
+        while True:
+            contact, normal, motion = self._decide(seen, allowed)
             try:
-                out = sim.execute(contact, seen.motion_to_world(motion), normal=normal)
+                out = sim.execute(contact, motion, normal=normal)
+                break
             except ReachabilityError:
                 allowed &= np.linalg.norm(seen.points - contact, axis=1) > UNREACHABLE_RADIUS
-                if attempt == MAX_REACH_RETRIES or not allowed.any():
+                retries += 1
+                if retries > MAX_REACH_RETRIES or not allowed.any():
                     raise
-                continue
-            out.success = bool(out.valid and rewards.success(self.name, out.pose_before, out.pose_after,
-                                                             seen.params, sim.obj))
-            return out
-        raise AssertionError("unreachable")  # the loop returns or raises
+        out.success = bool(out.valid and rewards.success(self.name, out.pose_before, out.pose_after,
+                                                         seen.params, sim.obj))
+        return out
 
     @property
     def success_model(self) -> SuccessModel:
