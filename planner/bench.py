@@ -3,7 +3,9 @@
 Each task draws an object from the procedural *test* split (never trained on), a scene (a wall with
 a gap between start and goal, two or three blocks, or an open table), a start (resting state by its
 probability, position on the near side, random yaw) and a goal (the far side; a different resting
-state in 40 % of tasks; a goal yaw in half of them). Both planners run the same task in the same
+state in 40 % of tasks; a goal yaw in half of them). Every task can be solved in principle: the start and
+the goal (at its yaw, when one is asked) are free, and the goal's resting state is reachable by a chain
+of rolls (:func:`primitives.params.roll_targets`). Both planners run the same task in the same
 simulator kind; success is the goal reached within 3 cm, 15 deg (when a yaw is asked) and in the
 right resting state, within ``max_primitives``.
 """
@@ -14,6 +16,7 @@ import math
 import time
 from dataclasses import asdict, dataclass, field
 
+import networkx as nx
 import numpy as np
 from tqdm import tqdm
 
@@ -21,6 +24,7 @@ from affordplan.errors import AffordplanError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel, random_object
 from affordplan.world import Box, Workspace
+from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, inflated_footprints, make_checkers
 from planner.predict import Predictor
 
@@ -98,20 +102,23 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
     radius = max(float(np.linalg.norm(obj.mesh.extents[:2])) / 2, 0.03)
     kind = str(rng.choice(["wall_gap", "blocks", "open"], p=[0.5, 0.3, 0.2]))
     footprints = inflated_footprints(obj, CLEARANCE)
+    rolls = RestingStateGraph(obj, lambda i, j: 1.0)  # the roll edges alone, no success model
     for _ in range(200):
         obstacles = _scene(rng, kind, radius)
         s0 = int(rng.choice(len(states), p=probs / probs.sum()))
         start = dict(resting_state=s0, xy=(float(rng.uniform(0.38, 0.46)), float(rng.uniform(-0.15, 0.15))),
                      yaw=float(rng.uniform(-math.pi, math.pi)))
         goal_state = s0
-        if len(states) > 1 and rng.random() < 0.4:
-            goal_state = int(rng.choice([s.index for s in states if s.index != s0]))
+        others = sorted(nx.descendants(rolls.graph, s0))  # states a chain of rolls can reach
+        if others and rng.random() < 0.4:
+            goal_state = int(rng.choice(others))
         goal = Goal(xy=(float(rng.uniform(0.64, 0.7)), float(rng.uniform(-0.12, 0.12))),
                     yaw=float(rng.uniform(-math.pi, math.pi)) if rng.random() < 0.5 else None,
                     resting_state=goal_state)
         checker = make_checkers(footprints, obstacles, workspace)
+        yaws = [goal.yaw] if goal.yaw is not None else np.linspace(-3.1, 3.1, 12)
         if checker[s0].is_free(*start["xy"], start["yaw"]) and \
-                any(checker[goal_state].is_free(*goal.xy, a) for a in np.linspace(-3.1, 3.1, 12)):
+                any(checker[goal_state].is_free(*goal.xy, a) for a in yaws):
             return Task(index, kind, obstacles, start, goal), obj
     raise AffordplanError(f"could not place a free start and goal for task {index}")
 

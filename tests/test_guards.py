@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import affordplan as ap
-from affordplan.sim.guards import PhysicsGuard
+from affordplan.sim.guards import GuardLimits, PhysicsGuard
 from affordplan.sim.scene import OBJECT_BODY
 
 
@@ -84,3 +84,21 @@ def test_a_faulty_start_is_never_a_valid_sample(cube):
     mujoco.mj_forward(sim.model, sim.data)
     out = sim.execute(T[:3, 3] - np.array([0.05, 0.0, 0.0]), (1.0, 0.0, 0.0))
     assert not out.valid and out.invalid_reason == "sank"
+
+
+def test_an_object_caught_mid_motion_is_left_at_rest(cube):
+    """A guard firing mid-push voids the sample, but the object comes to rest before the next primitive.
+
+    With a speed bound of 5 cm/s, the push trips ``"speed"`` while the cube slides. Left as it was, the
+    cube would carry that speed (or a transient 6 mm impact) into the next primitive, whose start check
+    would refuse it.
+    """
+    sim = ap.Simulator(cube, guard_limits=GuardLimits(max_linear_speed=0.05))
+    T = sim.reset()
+    out = sim.execute(T[:3, 3] + np.array([-0.05, 0.0, -0.02]), (1.0, 0.0, 0.0), normal=(-1.0, 0.0, 0.0))
+    assert not out.valid and out.invalid_reason == "speed"
+    moved = out.pose_after[:3, 3] - out.pose_before[:3, 3]
+    assert 0.0005 < moved[0] < 0.09  # it was pushed along +x before the guard stopped the push
+    v = sim.data.qvel[:6]
+    assert np.linalg.norm(v[:3]) < 0.01 and np.linalg.norm(v[3:]) < 0.1  # at rest now
+    assert sim.object_pose()[2, 3] == pytest.approx(T[2, 3], abs=0.002)  # on the table, as before

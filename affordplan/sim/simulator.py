@@ -91,6 +91,12 @@ class Outcome:
     arm_collisions: tuple[tuple[str, str], ...] = ()
 
 
+# Guard faults after which the object is left to settle (the primitive stays invalid): transients of a
+# sound simulation. NaN and instability leave nothing worth simulating; an object off the workspace or
+# resting off the table already is where it will stay.
+SETTLE_AFTER_FAULTS = ("sank", "speed")
+
+
 class _Abort(Exception):
     """Internal: a guard fired; carries its reason."""
 
@@ -247,10 +253,12 @@ class Simulator:
         self._guard.arm()
         self._collisions.clear()
         self._tracking.clear()
+        started = False
         try:
             reason = self._guard.check()  # a start already faulty (sunk, thrown) is never a valid sample
             if reason is not None:
                 raise _Abort(reason)
+            started = True
             # The arm comes down onto the pre-contact point from above: when something is in the way (a
             # handle over it), the approach fails without touching anything.
             if self._pusher.can_descend_to(pre):
@@ -269,6 +277,11 @@ class Simulator:
         except _Abort as abort:
             result.update(valid=False, invalid_reason=str(abort))
             self._pusher.home()
+            if started and str(abort) in SETTLE_AFTER_FAULTS:
+                # The sample is void, but the world goes on: an object caught mid-impact (6 mm into the
+                # table for a few milliseconds, say) comes to rest, so the next primitive starts from a
+                # settled state instead of inheriting the transient and being refused.
+                self._settle(p.settle_time_max, guarded=False)
         names = tuple(sorted({(self.model.geom(a).name, self.model.geom(b).name) for a, b in self._collisions}))
         return Outcome(
             pose_before=pose_before, pose_after=self.object_pose(),
@@ -316,11 +329,11 @@ class Simulator:
             if track:
                 self._tracking.append(float(np.linalg.norm(self._pusher.tip() - target)))
 
-    def _settle(self, max_time: float) -> None:
+    def _settle(self, max_time: float, guarded: bool = True) -> None:
         p = self.protocol
         still = 0
         for _ in range(self._chunks(max_time)):
-            self._step(CHUNK_STEPS)
+            self._step(CHUNK_STEPS, guarded)
             v = self.data.qvel[self._object_qvel:self._object_qvel + 6]
             if np.linalg.norm(v[:3]) < p.settle_linear_speed and np.linalg.norm(v[3:]) < p.settle_angular_speed:
                 still += 1
@@ -333,7 +346,7 @@ class Simulator:
         """Number of control chunks (at least one) covering ``duration`` seconds."""
         return max(1, round(duration / (CHUNK_STEPS * self.model.opt.timestep)))
 
-    def _step(self, n: int) -> None:
+    def _step(self, n: int, guarded: bool = True) -> None:
         t0 = time.perf_counter()
         mujoco.mj_step(self.model, self.data, nstep=n)
         self.physics_time += time.perf_counter() - t0
@@ -342,6 +355,8 @@ class Simulator:
             self._record_arm_collisions()
         if self.on_chunk is not None:
             self.on_chunk(self)
+        if not guarded:
+            return
         reason = self._guard.check()
         if reason is not None:
             raise _Abort(reason)

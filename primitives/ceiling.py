@@ -1,0 +1,188 @@
+"""How often can a push succeed at all? The best of scripted pushes, with privileged knowledge.
+
+    python -m primitives.ceiling --starts 100 --params random
+    python -m primitives.ceiling --starts 100 --params none --json
+
+A push-straight must move the object >= 5 cm and turn it < 5 deg. A point fingertip pushing a flat face
+turns the object unless the push line passes within a few millimetres of the centre of mass (a 10 cm
+cube pushed 1 cm off its centre line turns ~7 deg over 6 cm), and lying cylinders, capsules and
+ellipsoids roll whichever way they are pushed. This benchmark measures how much of the held-out
+family any push can move straight, so that a policy's success reads against what the pusher and the
+protocol allow.
+
+For each start of the evaluation (:func:`primitives.evaluate.evaluate`'s starts: the same objects,
+states and poses for the same ``--seed``), the simulator is restored to the start before each of
+``CANDIDATES`` scripted pushes:
+
+- **contacts** from a dense cloud (2048 points; the policy sees 256): on the surface facing the push
+  (normal against it by > 60 deg), the two nearest the line through the **centre of mass** along the
+  push (which no policy sees) in each of four height bands;
+- **motions**: along the push, 0.6-1.0 of the full 9 cm stroke, level or pressing down;
+- **directions**: the asked one (``--params random``), or eight around the circle (``--params none``,
+  where the seed's objective takes any direction; fewer contacts and strokes per direction).
+
+A start counts when any candidate meets the criterion. This is a bound from below on what a policy
+could reach with this fingertip and protocol (a cleverer candidate may exist), and the shipped policy's
+greedy success on the same starts is printed beside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from dataclasses import asdict, dataclass, field
+
+import mujoco
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from affordplan.sim.simulator import Simulator
+from primitives import rewards
+from primitives.env import EnvConfig, PrimitiveEnv
+from primitives.evaluate import greedy_action, load_policy
+
+CLOUD_POINTS = 2048
+HEIGHT_BANDS = ((0.05, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.95))  # fractions of the object's height
+FACING_COS = -0.5  # normal . push < this: the surface faces the push (by more than 60 deg)
+CANDIDATES = 64
+
+
+@dataclass(frozen=True)
+class Candidate:
+    contact: np.ndarray  # (3,) world, metres
+    normal: np.ndarray  # (3,) world, outward unit normal
+    motion: np.ndarray  # (3,) world, in [-1, 1] (x 3 cm per control step)
+
+
+def push_candidates(points: np.ndarray, normals: np.ndarray, com: np.ndarray, direction: float,
+                    per_band: int, strokes: tuple[float, ...], presses: tuple[float, ...]) -> list[Candidate]:
+    """Scripted pushes along the world yaw ``direction`` (radians) of an object whose centre of mass is ``com``.
+
+    ``points``, ``normals``: a dense world-frame cloud. In each height band, the ``per_band`` facing points
+    nearest the line through ``com`` along the push, each with every stroke (fraction of the full stroke)
+    and press (downward motion component).
+    """
+    d = np.array([math.cos(direction), math.sin(direction), 0.0])
+    facing = normals @ d < FACING_COS
+    rel = points - com
+    lateral = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0])  # distance from the push line through the COM
+    z0, z1 = points[:, 2].min(), points[:, 2].max()
+    out = []
+    for lo, hi in HEIGHT_BANDS:
+        band = facing & (points[:, 2] >= z0 + lo * (z1 - z0)) & (points[:, 2] <= z0 + hi * (z1 - z0))
+        idx = np.flatnonzero(band)
+        for i in idx[np.argsort(lateral[idx])[:per_band]]:
+            for s in strokes:
+                for press in presses:
+                    out.append(Candidate(points[i], normals[i], s * d + np.array([0.0, 0.0, -press])))
+    return out
+
+
+def candidates_for(sim: Simulator, params: dict | None, rng: np.random.Generator) -> list[Candidate]:
+    """The scripted pushes tried from the simulator's current state (see the module docstring)."""
+    points, normals = sim.point_cloud(CLOUD_POINTS)
+    com = sim.object_pose()[:3, 3]  # the object's body frame sits at its centre of mass
+    if params is not None:
+        return push_candidates(points, normals, com, params["direction"], 2, (0.6, 0.7, 0.85, 1.0), (0.0, 0.5))
+    offset = rng.uniform(0.0, math.pi / 4)
+    return [c for k in range(8)
+            for c in push_candidates(points, normals, com, offset + k * math.pi / 4, 1, (0.7, 1.0), (0.0,))]
+
+
+@dataclass
+class CeilingResult:
+    starts: int
+    params: str
+    any_success: int = 0  # starts where some candidate succeeded
+    policy_success: int = 0  # starts where the shipped policy's greedy push succeeded
+    candidate_success: list[float] = field(default_factory=list)  # per start, share of candidates that succeeded
+    per_kind: dict = field(default_factory=dict)  # object kind -> [starts, any_success, policy_success]
+
+    @property
+    def ceiling(self) -> float:
+        return self.any_success / max(1, self.starts)
+
+    @property
+    def policy(self) -> float:
+        return self.policy_success / max(1, self.starts)
+
+    def as_dict(self) -> dict:
+        d = asdict(self)
+        d.update(ceiling=self.ceiling, policy=self.policy,
+                 mean_candidate_success=float(np.mean(self.candidate_success)) if self.candidate_success else 0.0)
+        del d["candidate_success"]
+        return d
+
+    def report(self) -> str:
+        lines = [f"push ({self.params}): {self.starts} held-out starts",
+                 f"  best of scripted pushes (privileged COM, dense cloud): {self.ceiling:.3f}",
+                 f"  shipped policy, greedy, same starts:                   {self.policy:.3f}",
+                 f"  share of scripted pushes that succeed, mean over starts: {np.mean(self.candidate_success):.3f}",
+                 "  per object kind (starts: ceiling / policy):"]
+        for kind, (n, a, p) in sorted(self.per_kind.items()):
+            lines.append(f"    {kind:10s} {n:4d}: {a / n:.2f} / {p / n:.2f}")
+        return "\n".join(lines)
+
+
+def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, weights=None,
+                 progress: bool = True) -> CeilingResult:
+    """Best-of-scripted-pushes success on the evaluation's held-out starts (module docstring)."""
+    p_params = 1.0 if params == "random" else 0.0
+    env = PrimitiveEnv(EnvConfig("push", objects="test", n_objects=200, episodes_per_object=1, p_params=p_params),
+                       seed=seed)
+    model = load_policy(weights, "push")
+    rng = np.random.default_rng(seed)
+    result = CeilingResult(starts, params)
+    for _ in tqdm(range(starts), desc="push ceiling", disable=not progress, unit="start", mininterval=2.0):
+        obs = env.reset()
+        sim, prm = env.sim, env.params
+        start = mujoco.MjData(sim.model)
+        mujoco.mj_copyData(start, sim.model, sim.data)
+        wins = 0
+        cands = candidates_for(sim, prm, rng)
+        for c in cands:
+            mujoco.mj_copyData(sim.data, sim.model, start)
+            out = sim.execute(c.contact, c.motion, normal=c.normal)
+            wins += bool(out.valid and rewards.success("push", out.pose_before, out.pose_after, prm, sim.obj))
+        mujoco.mj_copyData(sim.data, sim.model, start)
+        idx, motion, _ = greedy_action(model, obs)
+        policy_ok = env.step(idx, motion).success
+        kind = sim.obj.name.rsplit("_", 1)[-1]
+        tally = result.per_kind.setdefault(kind, [0, 0, 0])
+        tally[0] += 1
+        tally[1] += wins > 0
+        tally[2] += policy_ok
+        result.any_success += wins > 0
+        result.policy_success += policy_ok
+        result.candidate_success.append(wins / max(1, len(cands)))
+    env.close()
+    return result
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m primitives.ceiling", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n  python -m primitives.ceiling --starts 100 --params random\n"
+               "  python -m primitives.ceiling --starts 100 --params none --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--starts", type=int, default=100, help="held-out starts (default: 100)")
+    p.add_argument("--params", choices=["none", "random"], default="random",
+                   help="random: a push direction is asked (default); none: the seed's objective, any direction")
+    p.add_argument("--seed", type=int, default=1234, help="the evaluation's seed: same starts (default: 1234)")
+    p.add_argument("--weights", default=None, help="push policy to compare with (default: shipped)")
+    p.add_argument("--json", action="store_true")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    torch.set_num_threads(1)
+    result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json)
+    print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,37 @@
+"""The push ceiling's scripted candidates: on the centre line, facing the push, and straight on a cube."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import affordplan as ap
+from primitives import rewards
+from primitives.ceiling import CLOUD_POINTS, candidates_for, push_candidates
+
+
+def test_candidates_face_the_push_and_hug_the_centre_line(cube):
+    sim = ap.Simulator(cube, seed=0)
+    T = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.3)
+    points, normals = sim.point_cloud(CLOUD_POINTS)
+    direction = math.radians(100.0)
+    d = np.array([math.cos(direction), math.sin(direction), 0.0])
+    cands = push_candidates(points, normals, T[:3, 3], direction, 2, (0.6, 1.0), (0.0,))
+    assert len(cands) == 4 * 2 * 2  # four height bands, two contacts, two strokes
+    rel = np.array([c.contact for c in cands]) - T[:3, 3]
+    assert np.all(np.array([c.normal for c in cands]) @ d < -0.5)
+    assert np.all(np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) < 0.01)  # within 1 cm of the line through the COM
+    assert np.allclose([c.motion[:2] / np.linalg.norm(c.motion[:2]) for c in cands], d[:2])
+
+
+def test_a_centre_line_push_moves_the_cube_straight(cube):
+    sim = ap.Simulator(cube, seed=0)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    params = {"direction": 0.0}
+    best = candidates_for(sim, params, np.random.default_rng(0))[2]  # lowest band, nearest the line, 0.7 of the stroke, level
+    out = sim.execute(best.contact, best.motion, normal=best.normal)
+    m = rewards.motion(out.pose_before, out.pose_after)
+    assert 0.05 <= m.p[0] <= 0.09 and abs(m.p[1]) < 0.01
+    assert m.theta_deg < 5.0
+    assert rewards.success("push", out.pose_before, out.pose_after, params, cube)
