@@ -29,7 +29,8 @@ def test_a_centre_line_push_moves_the_cube_straight(cube):
     sim = ap.Simulator(cube, seed=0)
     sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
     params = {"direction": 0.0}
-    best = candidates_for(sim, params, np.random.default_rng(0))[2]  # lowest band, nearest the line, 0.7 of the stroke, level
+    # lowest band, nearest the line, 0.7 of the stroke, level
+    best = candidates_for(sim, params, np.random.default_rng(0))[2]
     out = sim.execute(best.contact, best.motion, normal=best.normal)
     m = rewards.motion(out.pose_before, out.pose_after)
     assert 0.05 <= m.p[0] <= 0.09 and abs(m.p[1]) < 0.01
