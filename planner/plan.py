@@ -41,6 +41,9 @@ from planner.predict import Predictor, expected_pose, state_pose
 
 FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is avoided
 SPLIT_ANGLE = math.radians(35.0)
+# Turns tried, in order, on each side of a push that failed twice (the first is SPLIT_ANGLE): each detour
+# push must itself not have failed twice, or the plan would repeat a failure under another name.
+DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0, 110.0, 135.0))
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 
@@ -198,8 +201,8 @@ class Planner:
         T = state_pose(self.obj, state, *start)
         for call_state, skill, params, after in calls:
             if skill == "push" and self._avoided(skill, params, T):  # go round the failing direction
-                for side in (SPLIT_ANGLE, -SPLIT_ANGLE):
-                    p = {"direction": wrap_angle(params["direction"] + side)}
+                for direction in self._detour(params["direction"], T):
+                    p = {"direction": direction}
                     T_next = expected_pose(self.obj, "push", p, T)
                     steps.append(Step("push", p, T, T_next))
                     T = T_next
@@ -213,6 +216,25 @@ class Planner:
             for s, p in zip(steps, ps):
                 s.p_success = float(p)
         return steps
+
+    def _detour(self, direction: float, T: np.ndarray) -> list[float]:
+        """Pushes that stand in for a push along ``direction`` (radians) that failed twice from pose ``T``.
+
+        One push on each side of it, turned by the smallest of :data:`DETOUR_ANGLES` whose own direction has
+        not failed twice (the pair's sum still heads the same way when both turns are equal). A side where
+        every turn has failed is left out; when both are, the least-failed of all turns is tried.
+        """
+        pushes = []
+        for sign in (1.0, -1.0):
+            for turn in DETOUR_ANGLES:
+                d = float(wrap_angle(direction + sign * turn))
+                if not self._avoided("push", {"direction": d}, T):
+                    pushes.append(d)
+                    break
+        if pushes:
+            return pushes
+        turns = [float(wrap_angle(direction + sign * t)) for t in DETOUR_ANGLES for sign in (1.0, -1.0)]
+        return [min(turns, key=lambda d: self.failures[failure_key(self.obj, "push", {"direction": d}, T)])]
 
     def _path(self, state: int, start, goal, deadline: float) -> np.ndarray:
         left = deadline - time.perf_counter()

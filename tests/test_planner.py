@@ -145,6 +145,28 @@ def test_forced_failure_replans_without_repeating_the_failed_step():
     assert cube.classify(ex.final_pose) == direct
 
 
+def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
+    """Pushes towards the goal fail, and so does one side of the detour round them: neither is tried a third time.
+
+    The detour round a failing push is a push on each side of it; a detour direction that has itself failed
+    twice is turned further, instead of being planned (and failing) again on every replan.
+    """
+    cube = ap.load_object("cube")
+    failing = lambda params, state: -10.0 <= math.degrees(params["direction"]) <= 40.0  # noqa: E731
+    skills = {n: IdealSkill(n) for n in ("spin", "roll")}
+    skills["push"] = IdealSkill("push", fail=failing)
+    planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    goal = ap.Goal(xy=(0.62, 0.0), resting_state=0)
+    plan = planner.plan(cube.resting_states[0].pose((0.45, 0.0), 0.0), goal)
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=40)
+    assert ex.success, str(ex)
+    failed = [round(math.degrees(c[1]["direction"])) for c in skills["push"].calls if failing(c[1], c[0])]
+    buckets = [round(d / 45.0) for d in failed]  # the planner remembers failures per 45 deg sector
+    assert all(buckets.count(b) <= 2 for b in set(buckets)), failed
+
+
 def test_bad_goals_raise_their_errors():
     cube = ap.load_object("cube")
     planner = _planner(cube, WALL_WITH_GAP)
