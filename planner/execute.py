@@ -3,8 +3,9 @@
 :func:`execute_plan` runs a :class:`planner.plan.Plan` in a simulator: observe the object's pose; if
 the goal is reached, stop; if the pose is off the plan (more than ``XY_TOL`` / ``YAW_TOL`` from where
 the next step expects it, or in another resting state), replan from the observed pose; execute the
-next step's skill with its parameter; remember failures, so that a (state, skill, parameter) that
-failed twice is avoided by the next plan. It stops on success, on ``max_primitives``, or when no plan
+next step's skill with its parameter; remember failures (calls that did not move the object the way
+they asked: :func:`made_progress`), so that a (state, skill, parameter) that failed twice is avoided
+by the next plan. It stops on success, on ``max_primitives``, or when no plan
 can be found.
 
 :func:`execute_greedy` is the reactive baseline a user would otherwise reach for (HACMan-style):
@@ -134,6 +135,33 @@ def _terminal(out) -> str | None:
     return None
 
 
+# What counts as a failed call for the failure memory: a call that did not move the object the way it was
+# asked. The skills' own criteria are stricter (a push that slid 6 cm but turned 7 deg fails the seed's
+# push-straight); such a call still served the plan, and avoiding it sends the next plan round detours.
+MIN_PUSH_PROGRESS = 0.01  # metres along the asked direction
+MIN_SPIN_SHARE = 1.0 / 3.0  # of the asked turn, in the asked sense
+
+
+def made_progress(obj: ObjectModel, skill: str, params: dict, T_before: np.ndarray, T_after: np.ndarray) -> bool:
+    """Whether a call moved the object the way it was asked (see ``MIN_PUSH_PROGRESS``, ``MIN_SPIN_SHARE``).
+
+    A push moved it at least ``MIN_PUSH_PROGRESS`` along its direction in the same resting state; a spin
+    turned it at least ``MIN_SPIN_SHARE`` of the asked angle, in the asked sense, in the same state; a
+    roll left it in the target state.
+    """
+    s0, x0, y0, yaw0 = obj.planar_pose(T_before)
+    s1, x1, y1, yaw1 = obj.planar_pose(T_after)
+    if skill == "roll":
+        return s1 == params["target"]
+    if s1 != s0:
+        return False
+    if skill == "push":
+        a = params["direction"]
+        return (x1 - x0) * math.cos(a) + (y1 - y0) * math.sin(a) >= MIN_PUSH_PROGRESS
+    turn, asked = float(wrap_angle(yaw1 - yaw0)), params["angle"]
+    return turn * math.copysign(1.0, asked) >= MIN_SPIN_SHARE * abs(asked)
+
+
 def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
     """Run ``plan`` closed-loop (see the module docstring)."""
     planner, goal = plan.planner, plan.goal
@@ -173,7 +201,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
             log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc)))
             k = len(steps)
             continue
-        if not out.success:
+        if not made_progress(obj, step.skill, step.params, out.pose_before, out.pose_after):
             planner.record_failure(step.skill, step.params, T)
         log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
                             out.pose_after, replanned, step.p_success))

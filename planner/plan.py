@@ -43,7 +43,7 @@ FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is a
 SPLIT_ANGLE = math.radians(35.0)
 # Turns tried, in order, on each side of a push that failed twice (the first is SPLIT_ANGLE): each detour
 # push must itself not have failed twice, or the plan would repeat a failure under another name.
-DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0, 110.0, 135.0))
+DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  # never backwards
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 

@@ -167,6 +167,26 @@ def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
     assert all(buckets.count(b) <= 2 for b in set(buckets)), failed
 
 
+def test_failure_memory_counts_calls_that_did_not_move_the_object_as_asked():
+    """A push that slid 6 cm but turned 7 deg fails push-straight, yet served the plan: it is not held against it."""
+    from planner.execute import made_progress
+
+    cube = ap.load_object("cube")
+    T0 = cube.resting_states[0].pose((0.5, 0.0), 0.0)
+    slid = cube.resting_states[0].pose((0.56, 0.005), math.radians(7.0))
+    assert made_progress(cube, "push", {"direction": 0.0}, T0, slid)
+    assert not made_progress(cube, "push", {"direction": math.pi / 2}, T0, slid)  # it went the wrong way
+    assert not made_progress(cube, "push", {"direction": 0.0}, T0, T0)  # blocked: nothing moved
+    turned = cube.resting_states[0].pose((0.5, 0.0), math.radians(-12.0))
+    assert made_progress(cube, "spin", {"angle": math.radians(-30.0)}, T0, turned)
+    assert not made_progress(cube, "spin", {"angle": math.radians(30.0)}, T0, turned)
+    target = skill_params.roll_targets(cube, 0)[0]
+    rolled = cube.resting_states[target].pose((0.55, 0.0), 0.0)
+    assert made_progress(cube, "roll", {"target": target}, T0, rolled)
+    assert not made_progress(cube, "roll", {"target": target}, T0, slid)
+    assert not made_progress(cube, "push", {"direction": 0.0}, T0, rolled)  # tipped over: not a push's doing
+
+
 def test_bad_goals_raise_their_errors():
     cube = ap.load_object("cube")
     planner = _planner(cube, WALL_WITH_GAP)
