@@ -11,6 +11,7 @@ import pytest
 
 import affordplan as ap
 from affordplan.errors import GoalError, PlanningError
+from affordplan.geometry import wrap_angle
 from affordplan.sim.simulator import Outcome
 from planner import chain
 from planner.execute import execute_plan
@@ -185,6 +186,47 @@ def test_failure_memory_counts_calls_that_did_not_move_the_object_as_asked():
     assert made_progress(cube, "roll", {"target": target}, T0, rolled)
     assert not made_progress(cube, "roll", {"target": target}, T0, slid)
     assert not made_progress(cube, "push", {"direction": 0.0}, T0, rolled)  # tipped over: not a push's doing
+
+
+class SpinsBadlyIn(StubPredictor):
+    """Rates spins in one resting state at 0.05, every other call at 0.8."""
+
+    def __init__(self, skills, obj, state):
+        super().__init__(skills)
+        self.obj, self.state = obj, state
+
+    def p_success_many(self, queries):
+        return np.array([0.05 if skill == "spin" and self.obj.classify(T) == self.state else self.p
+                         for skill, _, T in queries])
+
+
+def test_a_goal_yaw_is_reached_before_the_roll_where_the_goal_state_does_not_spin():
+    """Where the success model says the goal's resting state cannot be spun, the turn is made before the roll."""
+    cube = ap.load_object("cube")
+    target = skill_params.roll_targets(cube, 0)[0]
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(100.0), resting_state=target)
+    T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
+
+    def spin_states(predictor):
+        planner = Planner(cube, (), predictor=predictor, time_limit=5.0, seed=0)
+        plan = planner.plan(T0, goal)
+        assert [s.skill for s in plan.steps].count("roll") == 1
+        return plan, [cube.classify(s.start_pose) for s in plan.steps if s.skill == "spin"]
+
+    plan, states = spin_states(SpinsBadlyIn(skills, cube, target))
+    assert states and set(states) == {0}  # every turn in the start state, none after the roll
+    roll = next(s for s in plan.steps if s.skill == "roll")
+    _, _, _, yaw_after_roll = cube.planar_pose(roll.expected_pose)
+    assert abs(math.degrees(wrap_angle(yaw_after_roll - goal.yaw))) < 15.0
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=30)
+    assert ex.success, str(ex)
+    assert not [e for e in ex.log if e.skill == "spin" and cube.classify(e.pose_before) == target]
+
+    _, states = spin_states(StubPredictor(skills))  # spins rated alike everywhere: turn where the goal is
+    assert target in states
 
 
 def test_bad_goals_raise_their_errors():
