@@ -46,7 +46,7 @@ from primitives.evaluate import greedy_action, load_policy
 CLOUD_POINTS = 2048
 HEIGHT_BANDS = ((0.05, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.95))  # fractions of the object's height
 FACING_COS = -0.5  # normal . push < this: the surface faces the push (by more than 60 deg)
-CANDIDATES = 64
+CANDIDATES = 64  # per start, at most (fewer where a height band has no facing points)
 
 
 @dataclass(frozen=True)
