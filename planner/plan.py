@@ -49,11 +49,6 @@ DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  #
 # side, say, cannot be spun; on its base it can).
 TURN_PROBE_ANGLE = math.radians(30.0)
 TURN_BEFORE_MARGIN = 0.15
-# Before pushing towards a goal that asks no yaw, the object is turned (by spins of up to 45 deg) to the
-# yaw from which the success model rates the push highest, when that beats the current yaw by this much.
-PUSH_YAW_TURNS = tuple(math.radians(d) for d in (0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0))
-PUSH_YAW_MARGIN = 0.2
-MIN_SPIN_PROBABILITY = 0.3
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 
@@ -199,10 +194,6 @@ class Planner:
             _, ax, ay, ayaw = self.obj.planar_pose(T_after)
             calls.append((a, "roll", {"target": b}, (ax, ay, ayaw)))
             cur = (ax, ay, ayaw)
-        if goal.yaw is None:  # any yaw will do: first turn to the one the pushes ahead work best from
-            for angle in chain.spins_for(self._push_yaw(goal_state, cur, goal.xy) - cur[2]):
-                cur = (cur[0], cur[1], float(wrap_angle(cur[2] + angle)))
-                calls.append((goal_state, "spin", {"angle": angle}, cur))
         goal_yaw = goal.yaw if goal.yaw is not None else self._free_yaw(goal_state, goal.xy, cur[2])
         path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
         paths.append((goal_state, path))
@@ -233,25 +224,6 @@ class Planner:
             for s, p in zip(steps, ps):
                 s.p_success = float(p)
         return steps
-
-    def _push_yaw(self, state: int, cur, xy) -> float:
-        """The yaw, within :data:`PUSH_YAW_TURNS` of ``cur``'s, from which pushes towards ``xy`` are likeliest.
-
-        Pushes succeed or fail by their direction relative to the object (a box pushed square to a face
-        slides, pushed on a corner it turns). The current yaw is kept unless the success model rates a
-        push from another one higher by :data:`PUSH_YAW_MARGIN`, spins work in this state, and the turned
-        footprint is free where the object stands.
-        """
-        x, y, yaw = cur
-        heading = math.atan2(xy[1] - y, xy[0] - x)
-        yaws = [float(wrap_angle(yaw + d)) for d in PUSH_YAW_TURNS]
-        ps = self.predictor.p_success_many([("push", {"direction": heading}, state_pose(self.obj, state, x, y, a))
-                                            for a in yaws])
-        best = int(np.argmax(ps))
-        if (ps[best] > ps[0] + PUSH_YAW_MARGIN and self._spin_probability(state) >= MIN_SPIN_PROBABILITY
-                and self.checkers[state].is_free(x, y, yaws[best])):
-            return yaws[best]
-        return float(yaw)
 
     def _spin_probability(self, state: int) -> float:
         """Predicted success of a 30 deg spin (mean of both ways) in ``state`` at the workspace centre."""

@@ -229,42 +229,6 @@ def test_a_goal_yaw_is_reached_before_the_roll_where_the_goal_state_does_not_spi
     assert target in states
 
 
-class PushesSquareOnly(StubPredictor):
-    """Rates a push 0.9 within 10 deg of square to a face of the cube, 0.1 otherwise; everything else 0.8."""
-
-    def __init__(self, skills, obj):
-        super().__init__(skills)
-        self.obj = obj
-
-    def p_success_many(self, queries):
-        def p(skill, params, T):
-            if skill != "push":
-                return self.p
-            relative = math.degrees(wrap_angle(params["direction"] - self.obj.planar_pose(T)[3]))
-            return 0.9 if abs((relative + 45.0) % 90.0 - 45.0) <= 10.0 else 0.1
-        return np.array([p(*q) for q in queries])
-
-
-def test_the_object_is_turned_first_to_where_its_pushes_work():
-    """A goal 45 deg off the cube's faces and no yaw asked: turn the cube, then push square to a face."""
-    cube = ap.load_object("cube")
-    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
-    T0 = cube.resting_states[0].pose((0.42, -0.1), 0.0)
-    goal = ap.Goal(xy=(0.62, 0.1))  # straight ahead at +45 deg: a corner-on push from yaw 0
-
-    planner = Planner(cube, (), predictor=PushesSquareOnly(skills, cube), time_limit=5.0, seed=0)
-    plan = planner.plan(T0, goal)
-    assert plan.steps[0].skill == "spin"
-    pushes = [s for s in plan.steps if s.skill == "push"]
-    assert pushes and all(s.p_success == pytest.approx(0.9) for s in pushes)
-    sim = ap.Simulator(cube, seed=0)
-    sim.set_object_pose(plan.start_pose, settle=False)
-    assert execute_plan(plan, sim=sim, max_primitives=20).success
-
-    plain = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0).plan(T0, goal)
-    assert "spin" not in [s.skill for s in plain.steps]  # pushes rated alike from every yaw: no turn
-
-
 def test_bad_goals_raise_their_errors():
     cube = ap.load_object("cube")
     planner = _planner(cube, WALL_WITH_GAP)
