@@ -102,16 +102,16 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
     radius = max(float(np.linalg.norm(obj.mesh.extents[:2])) / 2, 0.03)
     kind = str(rng.choice(["wall_gap", "blocks", "open"], p=[0.5, 0.3, 0.2]))
     footprints = inflated_footprints(obj, CLEARANCE)
-    rolls = RestingStateGraph(obj, lambda i, j: 1.0)  # the roll edges alone, no success model
+    rolls = RestingStateGraph(obj, lambda i, j: 1.0).graph  # the roll edges alone, no success model
+    reachable = {s.index: sorted(nx.descendants(rolls, s.index)) for s in states}  # by a chain of rolls
     for _ in range(200):
         obstacles = _scene(rng, kind, radius)
         s0 = int(rng.choice(len(states), p=probs / probs.sum()))
         start = dict(resting_state=s0, xy=(float(rng.uniform(0.38, 0.46)), float(rng.uniform(-0.15, 0.15))),
                      yaw=float(rng.uniform(-math.pi, math.pi)))
         goal_state = s0
-        others = sorted(nx.descendants(rolls.graph, s0))  # states a chain of rolls can reach
-        if others and rng.random() < 0.4:
-            goal_state = int(rng.choice(others))
+        if reachable[s0] and rng.random() < 0.4:
+            goal_state = int(rng.choice(reachable[s0]))
         goal = Goal(xy=(float(rng.uniform(0.64, 0.7)), float(rng.uniform(-0.12, 0.12))),
                     yaw=float(rng.uniform(-math.pi, math.pi)) if rng.random() < 0.5 else None,
                     resting_state=goal_state)

@@ -127,6 +127,7 @@ class Planner:
         self.clearance = clearance
         self.roll_margin = roll_margin
         self.failures: Counter = Counter()
+        self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
         self.footprints = inflated_footprints(obj, clearance)
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
@@ -146,8 +147,12 @@ class Planner:
             self.graph.penalise(key[0], params["target"])
         return self.failures[key]
 
+    def _failed(self, skill: str, params: dict, T: np.ndarray) -> int:
+        """How often this (state, skill, parameter) has failed."""
+        return self.failures[failure_key(self.obj, skill, params, T)]
+
     def _avoided(self, skill: str, params: dict, T: np.ndarray) -> bool:
-        return self.failures[failure_key(self.obj, skill, params, T)] >= FAILURES_TO_AVOID
+        return self._failed(skill, params, T) >= FAILURES_TO_AVOID
 
     def check_goal(self, goal: Goal, start_state: int) -> int:
         """The goal's resting state; raises :class:`GoalError` for goals that cannot be met."""
@@ -226,11 +231,16 @@ class Planner:
         return steps
 
     def _spin_probability(self, state: int) -> float:
-        """Predicted success of a 30 deg spin (mean of both ways) in ``state`` at the workspace centre."""
-        x, y = self.workspace.center
-        T = state_pose(self.obj, state, x, y, 0.0)
-        turns = [{"angle": a} for a in (TURN_PROBE_ANGLE, -TURN_PROBE_ANGLE)]
-        return float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
+        """Predicted success of a 30 deg spin (mean of both ways) in ``state`` at the workspace centre.
+
+        Like the graph's roll probabilities, it does not depend on where the object is: asked once per state.
+        """
+        if state not in self._spin_p:
+            x, y = self.workspace.center
+            T = state_pose(self.obj, state, x, y, 0.0)
+            turns = [{"angle": a} for a in (TURN_PROBE_ANGLE, -TURN_PROBE_ANGLE)]
+            self._spin_p[state] = float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
+        return self._spin_p[state]
 
     def _turns_better(self, before: int, goal_state: int) -> bool:
         """Whether the object spins clearly better in state ``before`` than in the goal's resting state."""
@@ -262,7 +272,7 @@ class Planner:
         if pushes:
             return pushes
         turns = [float(wrap_angle(direction + sign * t)) for t in DETOUR_ANGLES for sign in (1.0, -1.0)]
-        return [min(turns, key=lambda d: self.failures[failure_key(self.obj, "push", {"direction": d}, T)])]
+        return [min(turns, key=lambda d: self._failed("push", {"direction": d}, T))]
 
     def _path(self, state: int, start, goal, deadline: float) -> np.ndarray:
         left = deadline - time.perf_counter()

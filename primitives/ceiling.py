@@ -40,8 +40,8 @@ from tqdm import tqdm
 
 from affordplan.sim.simulator import Simulator
 from primitives import rewards
-from primitives.env import EnvConfig, PrimitiveEnv
-from primitives.evaluate import greedy_action, load_policy
+from primitives.env import PrimitiveEnv
+from primitives.evaluate import greedy_action, held_out_config, load_policy
 
 CLOUD_POINTS = 2048
 HEIGHT_BANDS = ((0.05, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.95))  # fractions of the object's height
@@ -130,8 +130,7 @@ def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, we
                  progress: bool = True) -> CeilingResult:
     """Best-of-scripted-pushes success on the evaluation's held-out starts (module docstring)."""
     p_params = 1.0 if params == "random" else 0.0
-    env = PrimitiveEnv(EnvConfig("push", objects="test", n_objects=200, episodes_per_object=1, p_params=p_params),
-                       seed=seed)
+    env = PrimitiveEnv(held_out_config("push", p_params), seed=seed)  # the evaluation's starts
     model = load_policy(weights, "push")
     rng = np.random.default_rng(seed)
     result = CeilingResult(starts, params)

@@ -90,6 +90,11 @@ class EvalResult:
                     per_object=self.rates())
 
 
+def held_out_config(primitive: str, p_params: float) -> EnvConfig:
+    """The environment of the held-out starts (procedural test split, one episode per drawn object)."""
+    return EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1, p_params=p_params)
+
+
 def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str, ...] = "random",
              trials: int = 200, seed: int = 1234, progress: bool = True, p_params: float = 0.0) -> EvalResult:
     """Success over ``trials`` stable starts (per object for ``seed7`` and paths).
@@ -98,7 +103,7 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
     every trial parameterised, judged by the parameterised criterion).
     """
     if objects == "random":
-        cfg = EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1, p_params=p_params)
+        cfg = held_out_config(primitive, p_params)
         plan = [None] * trials
     else:
         names = SEED_SEVEN if objects == "seed7" else tuple(objects)

@@ -253,12 +253,10 @@ class Simulator:
         self._guard.arm()
         self._collisions.clear()
         self._tracking.clear()
-        started = False
         try:
             reason = self._guard.check()  # a start already faulty (sunk, thrown) is never a valid sample
             if reason is not None:
                 raise _Abort(reason)
-            started = True
             # The arm comes down onto the pre-contact point from above: when something is in the way (a
             # handle over it), the approach fails without touching anything.
             if self._pusher.can_descend_to(pre):
@@ -277,7 +275,7 @@ class Simulator:
         except _Abort as abort:
             result.update(valid=False, invalid_reason=str(abort))
             self._pusher.home()
-            if started and str(abort) in SETTLE_AFTER_FAULTS:
+            if self.physics_steps > steps0 and str(abort) in SETTLE_AFTER_FAULTS:  # not a refused start
                 # The sample is void, but the world goes on: an object caught mid-impact (6 mm into the
                 # table for a few milliseconds, say) comes to rest, so the next primitive starts from a
                 # settled state instead of inheriting the transient and being refused.
