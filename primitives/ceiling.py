@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from dataclasses import asdict, dataclass, field
 
 import mujoco
@@ -38,6 +39,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from affordplan.errors import AffordplanError
 from affordplan.sim.simulator import Simulator
 from primitives import rewards
 from primitives.env import PrimitiveEnv
@@ -176,9 +178,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.starts < 1:
+        parser.error(f"--starts must be a positive integer, got {args.starts}")
     torch.set_num_threads(1)
-    result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json)
+    try:
+        result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json)
+    except AffordplanError as exc:  # missing or broken weights, ...
+        print(f"primitives.ceiling: error: {exc}", file=sys.stderr)
+        return 2
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     return 0
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +24,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from affordplan.errors import AffordplanError
 from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
 from primitives.networks import HybridActorCritic, widen_input
 
@@ -212,12 +214,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.trials < 1:
+        parser.error(f"--trials must be a positive integer, got {args.trials}")
     torch.set_num_threads(1)
-    model = load_policy(args.weights, args.primitive)
-    objects = args.objects[0] if args.objects[0] in ("random", "seed7") else tuple(args.objects)
-    result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
-                      p_params=1.0 if args.params == "random" else 0.0)
+    try:
+        model = load_policy(args.weights, args.primitive)
+        objects = args.objects[0] if args.objects[0] in ("random", "seed7") else tuple(args.objects)
+        result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
+                          p_params=1.0 if args.params == "random" else 0.0)
+    except AffordplanError as exc:  # missing or broken weights, an unreadable mesh, ...
+        print(f"primitives.evaluate: error: {exc}", file=sys.stderr)
+        return 2
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
     else:

@@ -1,10 +1,12 @@
-"""The push ceiling's scripted candidates: on the centre line, facing the push, and straight on a cube."""
+"""The push ceiling's scripted candidates (on the centre line, facing the push, straight on a cube), and its
+and the evaluation's command lines on bad input."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+import pytest
 
 import affordplan as ap
 from primitives import rewards
@@ -36,3 +38,22 @@ def test_a_centre_line_push_moves_the_cube_straight(cube):
     assert 0.05 <= m.p[0] <= 0.09 and abs(m.p[1]) < 0.01
     assert m.theta_deg < 5.0
     assert rewards.success("push", out.pose_before, out.pose_after, params, cube)
+
+
+def test_bad_command_lines_get_a_clear_error_not_a_traceback(tmp_path, capsys):
+    """Missing weights or a mesh that does not load: one line on stderr, exit status 2; no starts: a usage error."""
+    from primitives import ceiling, evaluate
+
+    missing = str(tmp_path / "nope.pt")
+    assert ceiling.main(["--starts", "1", "--weights", missing]) == 2
+    assert "no weights at" in capsys.readouterr().err
+    assert evaluate.main(["push", "--trials", "1", "--weights", missing]) == 2
+    assert "no weights at" in capsys.readouterr().err
+    broken = tmp_path / "broken.obj"
+    broken.write_text("not a mesh")
+    assert evaluate.main(["push", "--trials", "1", "--objects", str(broken)]) == 2
+    assert "primitives.evaluate: error:" in capsys.readouterr().err
+    for main, argv in ((ceiling.main, ["--starts", "0"]), (evaluate.main, ["push", "--trials", "0"])):
+        with pytest.raises(SystemExit) as exit_info:
+            main(argv)
+        assert exit_info.value.code == 2
