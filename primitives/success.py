@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 import zlib
 from dataclasses import dataclass
@@ -35,6 +36,7 @@ import torch.nn.functional as F
 from torch import nn
 from tqdm import tqdm
 
+from affordplan.errors import AffordplanError
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.networks import HybridActorCritic
 
@@ -324,10 +326,21 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.rollouts < 1:
+        parser.error(f"--rollouts must be a positive integer, got {args.rollouts}")
+    torch.set_num_threads(1)
+    try:
+        return _run(args)
+    except AffordplanError as exc:  # missing or broken policy or success model, ...
+        print(f"primitives.success: error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _run(args: argparse.Namespace) -> int:
     from primitives.evaluate import load_policy
 
-    args = build_parser().parse_args(argv)
-    torch.set_num_threads(1)
     out = Path(args.out or f"runs/{args.skill}_success")
     out.mkdir(parents=True, exist_ok=True)
     policy = load_policy(args.policy, args.skill)

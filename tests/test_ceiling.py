@@ -1,5 +1,5 @@
-"""The push ceiling's scripted candidates (on the centre line, facing the push, straight on a cube), and its
-and the evaluation's command lines on bad input."""
+"""The push ceiling's scripted candidates (on the centre line, facing the push, straight on a cube), and the
+command lines of the ceiling, the evaluation and the success models on bad input."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ def test_a_centre_line_push_moves_the_cube_straight(cube):
 
 def test_bad_command_lines_get_a_clear_error_not_a_traceback(tmp_path, capsys):
     """Missing weights or a mesh that does not load: one line on stderr, exit status 2; no starts: a usage error."""
-    from primitives import ceiling, evaluate
+    from primitives import ceiling, evaluate, success
 
     missing = str(tmp_path / "nope.pt")
     assert ceiling.main(["--starts", "1", "--weights", missing]) == 2
@@ -53,7 +53,10 @@ def test_bad_command_lines_get_a_clear_error_not_a_traceback(tmp_path, capsys):
     broken.write_text("not a mesh")
     assert evaluate.main(["push", "--trials", "1", "--objects", str(broken)]) == 2
     assert "primitives.evaluate: error:" in capsys.readouterr().err
-    for main, argv in ((ceiling.main, ["--starts", "0"]), (evaluate.main, ["push", "--trials", "0"])):
+    assert success.main(["evaluate", "spin", "--model", missing, "--rollouts", "1", "--out", str(tmp_path)]) == 2
+    assert "no success model at" in capsys.readouterr().err
+    for main, argv in ((ceiling.main, ["--starts", "0"]), (evaluate.main, ["push", "--trials", "0"]),
+                       (success.main, ["train", "spin", "--rollouts", "0"])):
         with pytest.raises(SystemExit) as exit_info:
             main(argv)
         assert exit_info.value.code == 2
