@@ -30,6 +30,7 @@ import torch
 from affordplan.errors import InputError
 from primitives.env import EnvConfig, PrimitiveEnv
 from primitives.networks import HybridActorCritic, choose_contact
+from primitives.scripted import scripted_push
 
 # (observation (n_points, 9) float16, contact index, motion (3,) float32 in [-1, 1], reward, success, valid)
 Transition = tuple[np.ndarray, int, np.ndarray, float, bool, bool]
@@ -43,11 +44,19 @@ class Exploration:
     temperature: float = 0.1  # softmax temperature over the critic map
     epsilon: float = 0.1  # share of uniformly drawn contacts
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion (motion units, [-1, 1])
+    p_scripted: float = 0.0  # push only: share of actions replaced by a scripted push (primitives.scripted)
 
 
 def act(model: HybridActorCritic, obs: np.ndarray, explore: Exploration, rng: np.random.Generator,
         gen: torch.Generator) -> tuple[int, np.ndarray]:
-    """Exploring contact index and motion for one observation (greedy acting: evaluate.greedy_action)."""
+    """Exploring contact index and motion for one observation (greedy acting: evaluate.greedy_action).
+
+    With probability ``explore.p_scripted`` (push only; :func:`primitives.train.check_config` says so) the
+    action is :func:`primitives.scripted.scripted_push` instead; with 0 no extra random number is drawn,
+    so runs without it are unchanged.
+    """
+    if explore.p_scripted > 0.0 and rng.random() < explore.p_scripted:
+        return scripted_push(obs, rng)
     actions, q = model.maps(torch.from_numpy(obs)[None])
     idx = int(choose_contact(q, explore.temperature, explore.epsilon, gen, greedy=False)[0])
     motion = actions[0, idx].numpy().astype(np.float64)

@@ -19,6 +19,10 @@ Read top to bottom, CleanRL style. Choices and why:
   asks for (HACMan's goal flow); otherwise the flow is zero and the seed's objective applies. One
   policy serves both. ``--init`` warm-starts from earlier weights (weights without the flow inputs
   are widened with zero weights, so the run starts from what they did).
+- **Scripted exploration (push, optional).** ``--p-scripted P`` replaces a share P of the exploring
+  actions by a scripted push along the line through the cloud's centre (:mod:`primitives.scripted`),
+  which succeeds about twice as often as early exploration; the critic regresses rewards, so these
+  off-policy samples need no correction.
 - **Invalid samples are dropped.** Primitives flagged by the physics guards never enter the replay.
 - **Workers.** ``--workers K`` runs K rollout workers (one torch thread each) that act with the
   latest weights and send transitions to this learner (:mod:`primitives.rollouts`): processes on
@@ -75,6 +79,7 @@ class TrainConfig:
     temperature: float = 0.1  # softmax temperature over the critic map (HACMan: 0.1)
     epsilon: float = 0.1  # uniform contact exploration (HACMan: 0.1)
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion
+    p_scripted: float = 0.0  # push only: share of exploring actions replaced by a scripted push
     replay_size: int = 50_000
     learning_starts: int = 1_000
     replay_ratio: float = 8.0  # at most this many sampled transitions per collected one
@@ -96,7 +101,7 @@ def env_config(cfg: TrainConfig) -> EnvConfig:
 
 def exploration(cfg: TrainConfig) -> Exploration:
     """How the training policy explores (workers and the in-process collector alike)."""
-    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise)
+    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted)
 
 
 def check_config(cfg: TrainConfig) -> None:
@@ -107,6 +112,10 @@ def check_config(cfg: TrainConfig) -> None:
         raise InputError("the ray backend runs one Ray actor per worker: give --workers 1 or more")
     if cfg.ray_address is not None and cfg.backend != "ray":
         raise InputError("--ray-address needs --backend ray")
+    if not 0.0 <= cfg.p_scripted <= 1.0:
+        raise InputError(f"--p-scripted is a probability, got {cfg.p_scripted}")
+    if cfg.p_scripted > 0.0 and cfg.primitive != "push":
+        raise InputError(f"--p-scripted exists for push only (primitives.scripted), not {cfg.primitive}")
 
 
 # ---------------------------------------------------------------------------- learning
@@ -317,6 +326,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-minutes", type=float, default=d.max_minutes, help="wall-time budget")
     p.add_argument("--p-params", type=float, default=d.p_params,
                    help="share of episodes that ask for a parameter (default: %(default)s; 0 = seed objective)")
+    p.add_argument("--p-scripted", type=float, default=d.p_scripted,
+                   help="push only: share of exploring actions replaced by a scripted push along the line "
+                        "through the cloud's centre (primitives.scripted; default: %(default)s)")
     p.add_argument("--init", default=None, help="start from these weights (e.g. primitives/weights/push.pt)")
     p.add_argument("--batch-size", type=int, default=d.batch_size)
     p.add_argument("--lr", type=float, default=d.lr)
@@ -339,7 +351,7 @@ def main(argv: list[str] | None = None) -> int:
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
         checkpoint_minutes=args.checkpoint_minutes, n_points=args.n_points, torch_threads=args.torch_threads,
-        p_params=args.p_params, init=args.init, weight_sync_updates=args.weight_sync_updates,
+        p_params=args.p_params, p_scripted=args.p_scripted, init=args.init, weight_sync_updates=args.weight_sync_updates,
     )
     try:
         check_config(cfg)
