@@ -49,6 +49,10 @@ DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  #
 # side, say, cannot be spun; on its base it can).
 TURN_PROBE_ANGLE = math.radians(30.0)
 TURN_BEFORE_MARGIN = 0.15
+# Where the goal's resting state spins this badly (predicted, or spins there failed twice) and no roll into
+# it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
+# rolls back (when the two rolls and a spin there are likelier than a spin in the goal state).
+SPIN_DETOUR_BELOW = 0.3
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 
@@ -175,6 +179,8 @@ class Planner:
         state, x, y, yaw = self.obj.planar_pose(T_start)
         goal_state = self.check_goal(goal, state)
         route = self.graph.route(state, goal_state)
+        if goal.yaw is not None:
+            route = self._route_to_turn(route, yaw, goal)
         calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
         paths: list[tuple[int, np.ndarray]] = []
         cur = (x, y, yaw)
@@ -182,10 +188,11 @@ class Planner:
             free = self._nearest_free(state, cur)
             calls.append((state, "push", {"direction": math.atan2(free[1] - y, free[0] - x)}, (*free, yaw)))
             cur = (*free, yaw)
-        for a, b in zip(route, route[1:]):
+        for k, (a, b) in enumerate(zip(route, route[1:])):
             spot = self._roll_spot(a, b, cur, goal)
             want_yaw = cur[2]
-            if goal.yaw is not None and b == goal_state and self._turns_better(a, goal_state):
+            last_roll = k == len(route) - 2
+            if goal.yaw is not None and last_roll and self._turns_better(a, goal_state):
                 want_yaw = self._yaw_before_roll(a, b, spot, goal.yaw)  # turn here, arrive turned
             spot_yaw = self._free_yaw(a, spot, want_yaw)
             path = self._path(a, cur, (*spot, spot_yaw), deadline)
@@ -242,9 +249,37 @@ class Planner:
             self._spin_p[state] = float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
         return self._spin_p[state]
 
+    def _spin_rating(self, state: int) -> float:
+        """:meth:`_spin_probability`, or 0 where a spin in ``state`` (either way) has failed twice."""
+        if any(self.failures[(state, "spin", sense)] >= FAILURES_TO_AVOID for sense in (1, -1)):
+            return 0.0
+        return self._spin_probability(state)
+
     def _turns_better(self, before: int, goal_state: int) -> bool:
         """Whether the object spins clearly better in state ``before`` than in the goal's resting state."""
-        return self._spin_probability(before) > self._spin_probability(goal_state) + TURN_BEFORE_MARGIN
+        return self._spin_rating(before) > self._spin_rating(goal_state) + TURN_BEFORE_MARGIN
+
+    def _route_to_turn(self, route: list[int], yaw: float, goal: Goal) -> list[int]:
+        """``route``, or ``route`` plus a roll away from the goal's state and back, to turn the object there.
+
+        The detour is taken when a turn is needed (the route rolls, or the start's yaw is off the goal's), the
+        goal's state spins badly (:data:`SPIN_DETOUR_BELOW`), the route's last roll does not come from a state
+        that spins better (:meth:`_turns_better`: the turn is made there), and for the best neighbour ``s``,
+        ``P(roll g->s) P(spin in s) P(roll s->g)`` beats ``P(spin in g)``.
+        """
+        g = route[-1]
+        if len(route) == 1 and abs(wrap_angle(goal.yaw - yaw)) <= goal.yaw_tol:
+            return route
+        if self._spin_rating(g) >= SPIN_DETOUR_BELOW or (len(route) > 1 and self._turns_better(route[-2], g)):
+            return route
+        best, best_p = None, self._spin_rating(g)
+        for s in self.graph.graph.successors(g):
+            if s == g or not self.graph.graph.has_edge(s, g) or not self._turns_better(s, g):
+                continue
+            p = self.graph.probability(g, s) * self._spin_rating(s) * self.graph.probability(s, g)
+            if p > best_p:
+                best, best_p = int(s), p
+        return route if best is None else route + [best, g]
 
     def _yaw_before_roll(self, a: int, b: int, spot, goal_yaw: float) -> float:
         """Yaw in state ``a`` at ``spot`` from which the roll to ``b`` ends at ``goal_yaw`` (ideally).

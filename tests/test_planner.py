@@ -229,6 +229,35 @@ def test_a_goal_yaw_is_reached_before_the_roll_where_the_goal_state_does_not_spi
     assert target in states
 
 
+def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn():
+    """Start and goal share a resting state that the success model says cannot be spun: roll away, turn, roll back."""
+    cube = ap.load_object("cube")
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(110.0), resting_state=0)
+    T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
+    plan = Planner(cube, (), predictor=SpinsBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, goal)
+    assert plan.route[0] == plan.route[-1] == 0 and len(plan.route) == 3
+    assert [s.skill for s in plan.steps].count("roll") == 2
+    assert {cube.classify(s.start_pose) for s in plan.steps if s.skill == "spin"} == {plan.route[1]}
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=30)
+    assert ex.success, str(ex)
+    assert not [e for e in ex.log if e.skill == "spin" and cube.classify(e.pose_before) == 0]
+
+    # spins rated alike everywhere, or no turn needed: no detour
+    plan = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0).plan(T0, goal)
+    assert plan.route == [0] and "roll" not in [s.skill for s in plan.steps]
+    # spins in the goal state that failed twice count as a state that cannot be spun
+    planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    for _ in range(2):
+        planner.record_failure("spin", {"angle": math.radians(45.0)}, T0)
+    assert len(planner.plan(T0, goal).route) == 3
+    aligned = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(5.0), resting_state=0)
+    plan = Planner(cube, (), predictor=SpinsBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, aligned)
+    assert plan.route == [0]
+
+
 def test_bad_goals_raise_their_errors():
     cube = ap.load_object("cube")
     planner = _planner(cube, WALL_WITH_GAP)
