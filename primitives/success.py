@@ -12,6 +12,10 @@ planner, which asks it often. Choices and why:
   the spread of the critic map, the contact's position and normal and the chosen motion. These are
   functions of the cloud and the parameter (the policy is deterministic at evaluation), and they
   carry the critic's estimate of the outcome, which the model only has to calibrate and correct.
+- **Ensemble.** ``--members K`` trains K such PointNets from different initialisations and batch
+  orders on the same data and averages their logits before calibration: a deep ensemble ranks
+  outcomes better than its members (their errors differ), at K times the query cost of the nets,
+  which is small beside the policy's decision.
 - **Data** are greedy rollouts of the policy on the procedural training split (85 % with a random
   parameter, 15 % the seed's objective); physics-guard failures are dropped as in training.
 - **Calibration.** After fitting (binary cross-entropy), Platt scaling (``sigmoid(a z + b)``) is fitted
@@ -63,26 +67,57 @@ def decision_features(policy: HybridActorCritic, obs: torch.Tensor) -> tuple[tor
     return idx, motion, feats
 
 
-class SuccessNet(nn.Module):
-    """Logit of success from an observation ``(B, N, 9)`` and decision features ``(B, 13)``."""
+class _Member(nn.Module):
+    """One PointNet of the ensemble: logit from scaled points ``(B, N, 9)`` and decision features ``(B, 13)``."""
 
-    def __init__(self, in_dim: int = OBS_DIM, width: int = 64):
+    def __init__(self, in_dim: int, width: int):
         super().__init__()
         self.points = nn.Sequential(nn.Linear(in_dim, width), nn.ReLU(), nn.Linear(width, 2 * width), nn.ReLU())
         self.head = nn.Sequential(nn.Linear(4 * width + N_DECISION, 2 * width), nn.ReLU(),
                                   nn.Linear(2 * width, width), nn.ReLU(), nn.Linear(width, 1))
+
+    def forward(self, x: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+        h = self.points(x)
+        return self.head(torch.cat([h.amax(dim=1), h.mean(dim=1), decision], dim=1)).squeeze(-1)
+
+
+class SuccessNet(nn.Module):
+    """Logit of success from an observation ``(B, N, 9)`` and decision features ``(B, 13)``.
+
+    The mean logit of ``members`` independently initialised and trained PointNets (a deep ensemble: it ranks
+    outcomes better than any one member), then one Platt scaling of that mean.
+    """
+
+    def __init__(self, in_dim: int = OBS_DIM, width: int = 64, members: int = 1):
+        super().__init__()
+        if members < 1:
+            raise ValueError(f"an ensemble needs at least one member, got {members}")
+        self.members = nn.ModuleList(_Member(in_dim, width) for _ in range(members))
         # Platt scaling, fitted after training: p = sigmoid(a * logit + b).
         self.register_buffer("platt", torch.tensor([1.0, 0.0]))
 
+    @staticmethod
+    def scaled(obs: torch.Tensor) -> torch.Tensor:
+        """The members' input: observation features at about unit scale (positions in dm, flow in 5 cm)."""
+        return obs * torch.tensor([10, 10, 10, 1, 1, 1, 20, 20, 20.0])
+
     def logit(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
-        x = obs * torch.tensor([10, 10, 10, 1, 1, 1, 20, 20, 20.0])  # metres -> ~unit scale
-        h = self.points(x)
-        g = torch.cat([h.amax(dim=1), h.mean(dim=1), decision], dim=1)
-        return self.head(g).squeeze(-1)
+        x = self.scaled(obs)
+        return torch.stack([m(x, decision) for m in self.members]).mean(dim=0)
 
     def forward(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
         """Calibrated probability of success ``(B,)``."""
         return torch.sigmoid(self.platt[0] * self.logit(obs, decision) + self.platt[1])
+
+    @classmethod
+    def from_state_dict(cls, state: dict) -> SuccessNet:
+        """A net of as many members as ``state`` holds; files from before ensembles hold one, unprefixed."""
+        if any(k.startswith(("points.", "head.")) for k in state):
+            state = {(k if k == "platt" else f"members.0.{k}"): v for k, v in state.items()}
+        members = 1 + max(int(k.split(".")[1]) for k in state if k.startswith("members."))
+        net = cls(members=members)
+        net.load_state_dict(state)
+        return net
 
 
 class SuccessModel:
@@ -219,38 +254,43 @@ def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, titl
 
 # ----------------------------------------------------------------------------- training
 def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, lr: float = 1e-3,
-        calib_fraction: float = 0.2, progress: bool = True) -> tuple[SuccessNet, dict]:
-    """Train a :class:`SuccessNet` on rollouts; Platt-scale it on a held-out share of their objects."""
+        calib_fraction: float = 0.2, members: int = 1, progress: bool = True) -> tuple[SuccessNet, dict]:
+    """Train a :class:`SuccessNet` of ``members`` PointNets on rollouts; Platt-scale it on a held-out share of
+    their objects. Every member sees the same training split, from its own initialisation and batch order."""
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
     groups = np.unique(data.group)
     calib_groups = rng.choice(groups, size=max(1, int(calib_fraction * len(groups))), replace=False)
     calib_mask = np.isin(data.group, calib_groups)
     train, calib = data.subset(~calib_mask), data.subset(calib_mask)
-    net = SuccessNet()
-    opt = torch.optim.Adam(net.parameters(), lr=lr, weight_decay=1e-5)
-    obs = torch.from_numpy(train.obs.astype(np.float32))
+    net = SuccessNet(members=members)
+    x = SuccessNet.scaled(torch.from_numpy(train.obs.astype(np.float32)))
     dec = torch.from_numpy(train.decision)
     y = torch.from_numpy(train.success.astype(np.float32))
-    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=epochs)
-    gen = torch.Generator().manual_seed(seed)
-    for _ in tqdm(range(epochs), desc="fit success model", disable=not progress, unit="epoch"):
-        net.train()
-        perm = torch.randperm(len(y), generator=gen)
-        for i in range(0, len(y), batch_size):
-            b = perm[i:i + batch_size]
-            loss = F.binary_cross_entropy_with_logits(net.logit(obs[b], dec[b]), y[b])
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
-        sched.step()
+    bar = tqdm(total=members * epochs, desc="fit success model", disable=not progress, unit="epoch")
+    for k, member in enumerate(net.members):
+        opt = torch.optim.Adam(member.parameters(), lr=lr, weight_decay=1e-5)
+        sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=epochs)
+        gen = torch.Generator().manual_seed(seed + 1000 * k)
+        member.train()
+        for _ in range(epochs):
+            perm = torch.randperm(len(y), generator=gen)
+            for i in range(0, len(y), batch_size):
+                b = perm[i:i + batch_size]
+                loss = F.binary_cross_entropy_with_logits(member(x[b], dec[b]), y[b])
+                opt.zero_grad()
+                loss.backward()
+                opt.step()
+            sched.step()
+            bar.update(1)
+    bar.close()
     net.eval()
     with torch.no_grad():
         z = net.logit(torch.from_numpy(calib.obs.astype(np.float32)), torch.from_numpy(calib.decision))
     a_b = _platt(z, torch.from_numpy(calib.success.astype(np.float32)))
     net.platt.copy_(a_b)
     p_cal = torch.sigmoid(a_b[0] * z + a_b[1]).numpy()  # what net(...) now returns on the calibration set
-    return net, dict(train=len(train), calibration=len(calib), platt=a_b.tolist(),
+    return net, dict(train=len(train), calibration=len(calib), members=members, platt=a_b.tolist(),
                      calibration_metrics=metrics(p_cal, calib.success))
 
 
@@ -285,8 +325,7 @@ def load_success_net(skill: str, path: str | os.PathLike | None = None) -> Succe
         raise ckpt.CheckpointError(f"no success model at {path}")
     try:
         state = torch.load(path, map_location="cpu", weights_only=False)
-        net = SuccessNet()
-        net.load_state_dict(state["model"])
+        net = SuccessNet.from_state_dict(state["model"])
     except Exception as exc:
         raise ckpt.CheckpointError(f"success model {path} is damaged ({type(exc).__name__}: {exc})") from exc
     return net.eval()
@@ -322,6 +361,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub.choices["evaluate"].add_argument("--model", default=None, help="success model (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
     sub.choices["train"].add_argument("--epochs", type=int, default=40)
+    sub.choices["train"].add_argument("--members", type=int, default=1,
+                                      help="PointNets in the ensemble, their logits averaged (default: %(default)s)")
     return p
 
 
@@ -330,6 +371,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.rollouts < 1:
         parser.error(f"--rollouts must be a positive integer, got {args.rollouts}")
+    if getattr(args, "members", 1) < 1:
+        parser.error(f"--members must be a positive integer, got {args.members}")
     torch.set_num_threads(1)
     try:
         return _run(args)
@@ -349,7 +392,7 @@ def _run(args: argparse.Namespace) -> int:
         data = Rollouts.load(cache) if cache.exists() else collect(policy, args.skill, args.rollouts, "train",
                                                                    seed=args.seed, progress=not args.json)
         data.save(cache)
-        net, info = fit(data, seed=args.seed, epochs=args.epochs, progress=not args.json)
+        net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json)
         info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped")
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))

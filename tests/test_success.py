@@ -44,6 +44,40 @@ def test_fit_learns_and_calibrates_on_synthetic_rollouts():
     assert abs(m["mean_prediction"] - m["success_rate"]) < 0.05
 
 
+def test_an_ensemble_averages_its_members_and_round_trips(tmp_path):
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(1)
+    net, info = success.fit(_synthetic(1200, rng), seed=0, epochs=6, members=2, progress=False)
+    assert len(net.members) == 2 and info["members"] == 2
+    test = _synthetic(600, rng)
+    obs, dec = torch.from_numpy(test.obs.astype(np.float32)), torch.from_numpy(test.decision)
+    with torch.no_grad():
+        x = success.SuccessNet.scaled(obs)
+        mean_logit = (net.members[0](x, dec) + net.members[1](x, dec)) / 2
+        assert torch.allclose(net.logit(obs, dec), mean_logit)
+        assert not torch.allclose(net.members[0](x, dec), net.members[1](x, dec))  # trained apart
+        p = net(obs, dec).numpy()
+    assert success.metrics(p, test.success)["auroc"] > 0.8
+    success.save(net, tmp_path / "e.pt", info)
+    again = success.load_success_net("push", tmp_path / "e.pt")
+    with torch.no_grad():
+        assert np.allclose(again(obs, dec).numpy(), p)
+
+
+def test_a_single_net_file_from_before_ensembles_loads(tmp_path):
+    torch.manual_seed(0)
+    net = success.SuccessNet()
+    net.platt.copy_(torch.tensor([0.9, 0.1]))
+    legacy = {k.removeprefix("members.0."): v for k, v in net.state_dict().items()}  # the old key names
+    assert "points.0.weight" in legacy
+    torch.save(dict(model=legacy, info={}), tmp_path / "old.pt")
+    loaded = success.load_success_net("push", tmp_path / "old.pt")
+    obs = torch.from_numpy(np.random.default_rng(0).normal(0, 0.03, size=(4, 32, 9)).astype(np.float32))
+    dec = torch.zeros(4, success.N_DECISION)
+    with torch.no_grad():
+        assert len(loaded.members) == 1 and torch.allclose(loaded(obs, dec), net(obs, dec))
+
+
 def test_model_answers_single_and_batched_queries(tmp_path):
     torch.manual_seed(0)
     model = success.SuccessModel(HybridActorCritic(), success.SuccessNet())
