@@ -8,7 +8,8 @@ Kept apart in OMPL's way:
   table footprints (an object standing on the table meets every obstacle it overlaps in plan).
 * :func:`make_space`: the SE(2) state space (``ob.SE2StateSpace``) bounded by the workspace.
 * :func:`make_setup`: an ``og.SimpleSetup`` with the checker and an ``og.RRTConnect`` planner.
-* :func:`plan_path`: start/goal checks, solve, simplify, densify, final check.
+* :func:`plan_path`: start/goal checks, the straight way when it is free, else solve, simplify, hold
+  one yaw where that is free (:func:`single_turn_path`), densify, final check.
 
 Distances in SE(2) are OMPL's compound metric ``|dxy| + yaw_weight |dyaw|`` (metres; ``dyaw`` in
 radians, the shorter way round): ``SE2StateSpace`` weighs its SO(2) subspace by 0.5 by default, and
@@ -284,6 +285,102 @@ def interpolate_path(path: np.ndarray, max_step: float = MAX_STEP, max_turn: flo
     return np.vstack(out)
 
 
+def _free_along(checker: FootprintChecker, path: np.ndarray, resolution: float) -> bool:
+    """Whether the footprint is free at every state of ``path`` subdivided to ``resolution`` metres and 2 deg."""
+    return all(checker.is_free(*pose) for pose in interpolate_path(path, resolution, math.radians(2.0)))
+
+
+def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray,
+                     resolution: float = 0.005) -> np.ndarray | None:
+    """``waypoints``' positions at one held yaw with a single turn in place, when that stays free; else ``None``.
+
+    Tried in order: turn at the first waypoint to the last one's yaw and hold it, or hold the first one's yaw
+    and turn at the last waypoint. Every executed turn is a spin, which moves objects sideways by centimetres,
+    and every change of heading along a sampled path is one more: where one turn will do, this is the path
+    with fewest spins. Checked every ``resolution`` metres and every 2 deg; returned densified like
+    :func:`plan_path`'s paths.
+    """
+    waypoints = np.asarray(waypoints, dtype=float)
+    (x0, y0, a0), (x1, y1, a1) = waypoints[0], waypoints[-1]
+    a1 = a0 + wrap_angle(a1 - a0)
+    xy = waypoints[:, :2]
+    for held in (a1, a0):
+        path = np.column_stack([xy, np.full(len(xy), held)])
+        path = np.vstack([[x0, y0, a0], path]) if held == a1 else np.vstack([path, [x1, y1, a1]])
+        if _free_along(checker, path, resolution):
+            return interpolate_path(path)
+    return None
+
+
+def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *, time_limit: float = 0.1,
+                     seed: int = 0, resolution: float = 0.005) -> np.ndarray | None:
+    """Positions ``(m, 2)`` from ``start_xy`` to ``goal_xy`` along which the footprint at ``yaw`` stays free, or
+    ``None`` when RRT-Connect (OMPL, in the plane) finds none within ``time_limit`` seconds.
+
+    The waypoints are simplified by OMPL; motions are checked every ``resolution`` metres.
+    """
+    if not (checker.is_free(start_xy[0], start_xy[1], yaw) and checker.is_free(goal_xy[0], goal_xy[1], yaw)):
+        return None
+    space = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    for i, (lo, hi) in enumerate((checker.workspace.x, checker.workspace.y)):
+        bounds.setLow(i, lo)
+        bounds.setHigh(i, hi)
+    space.setBounds(bounds)
+    setup = planner = None
+    try:
+        with _ompl_log_level(ou.LOG_WARN):
+            _seed_ompl(int(seed))
+            setup = og.SimpleSetup(space)
+            is_free = checker.is_free
+            setup.setStateValidityChecker(lambda state: is_free(state[0], state[1], yaw))
+            si = setup.getSpaceInformation()
+            si.setStateValidityCheckingResolution(min(1.0, resolution / space.getMaximumExtent()))
+            planner = og.RRTConnect(si)
+            setup.setPlanner(planner)
+            ends = []
+            for xy in (start_xy, goal_xy):
+                state = space.allocState()  # Python-owned: never freeState it (see the module docstring)
+                state[0], state[1] = float(xy[0]), float(xy[1])
+                ends.append(state)
+            setup.setStartAndGoalStates(*ends)
+            result = setup.solve(time_limit)
+            if result.getStatus() != ob.PlannerStatus.EXACT_SOLUTION or not setup.haveExactSolutionPath():
+                return None
+            setup.simplifySolution(0.0)  # 0: simplify to the end (no time limit, so deterministic)
+            states = setup.getSolutionPath().getStates()
+            xy = np.array([(st[0], st[1]) for st in states])
+            del states
+    finally:
+        del planner, setup
+    xy[0], xy[-1] = start_xy, goal_xy
+    return xy
+
+
+def _turn_once(checker: FootprintChecker, start, goal, *, time_limit: float, seed: int,
+               resolution: float) -> np.ndarray | None:
+    """A path that turns once, in place, at the start or at the goal, and moves at one held yaw (or ``None``).
+
+    The straight way first (:func:`single_turn_path`), then a plane path at the goal's yaw after turning at
+    the start, then one at the start's yaw before turning at the goal (:func:`plan_at_held_yaw`).
+    """
+    path = single_turn_path(checker, np.array([start, goal], dtype=float), resolution)
+    if path is not None:
+        return path
+    (x0, y0, a0), (x1, y1, a1) = start, goal
+    a1 = a0 + wrap_angle(a1 - a0)
+    for held in dict.fromkeys((a1, a0)):  # turn at the start, or at the goal
+        xy = plan_at_held_yaw(checker, (x0, y0), (x1, y1), held, time_limit=time_limit, seed=seed,
+                              resolution=resolution)
+        if xy is None:
+            continue
+        moving = np.column_stack([xy, np.full(len(xy), held)])
+        path = np.vstack([[x0, y0, a0], moving]) if held == a1 else np.vstack([moving, [x1, y1, a1]])
+        if _free_along(checker, path, resolution):
+            return interpolate_path(path)
+    return None
+
+
 def path_length(path: np.ndarray, yaw_weight: float = 0.05) -> float:
     """Length of an SE(2) path in OMPL's compound metric: sum of ``|dxy| + yaw_weight |dyaw|`` (metres)."""
     path = np.asarray(path, dtype=float)
@@ -316,6 +413,7 @@ def plan_path(
     resolution: float = 0.005,
     yaw_weight: float = 0.05,
     attempts: int = 1,
+    single_turn: bool = True,
 ) -> np.ndarray:
     """Collision-free SE(2) path of the checker's footprint from ``start`` to ``goal``.
 
@@ -323,6 +421,10 @@ def plan_path(
     ``resolution`` of SE(2) distance, then OMPL's simplifier, then subdivision to steps of at most
     1 cm and 5 deg. Every returned state, and every state OMPL checked along the simplified path, is
     re-checked with ``checker.is_free``.
+
+    With ``single_turn`` (the default), paths turn once, in place (:func:`single_turn_path`), wherever that
+    is free: the straight way is returned without sampling when it is free, and a sampled path's positions
+    are kept at one held yaw when they can be. A planner that executes turns as spins then spins least.
 
     RRT-Connect is not optimising and the simplifier keeps a path's homotopy class, so a path may turn
     a full extra revolution (e.g. pass a gap at yaw + pi): with ``attempts > 1`` the planner restarts
@@ -337,6 +439,7 @@ def plan_path(
         resolution: SE(2) distance between checked states along a motion, metres-equivalent.
         yaw_weight: metres that one radian of yaw counts for in the SE(2) metric.
         attempts: independent RRT-Connect runs; the shortest exact solution is returned.
+        single_turn: prefer paths that turn once (:func:`single_turn_path`).
 
     Returns:
         (n, 3) array of (x, y, yaw), world frame; ``path[0] == start``; yaw is continuous
@@ -362,6 +465,11 @@ def plan_path(
         reason = checker.why_not_free(*pose)
         if reason is not None:
             raise GoalError(f"{name} {pose} is not free: {reason}")
+    if single_turn:
+        path = _turn_once(checker, start, goal, time_limit=min(0.1, time_limit / 4), seed=int(seed),
+                          resolution=resolution)
+        if path is not None:
+            return path
 
     space = make_space(checker.workspace, yaw_weight)
     setup = planner = None
@@ -398,6 +506,10 @@ def plan_path(
     _, waypoints, counts = best
     waypoints[0] = (start[0], start[1], wrap_angle(start[2]))
     waypoints[-1] = (goal[0], goal[1], wrap_angle(goal[2]))
+    if single_turn:  # the sampled way, turning once
+        path = single_turn_path(checker, waypoints, resolution)
+        if path is not None:
+            return path
     waypoints[:, 2] = np.unwrap(waypoints[:, 2]) + (start[2] - waypoints[0, 2])  # continuous from start's yaw
     # Re-check every state OMPL's motion validator saw (and the returned ones among them) in Python:
     # the returned path is only as safe as this check.

@@ -120,8 +120,9 @@ def test_checker_agrees_with_a_separating_axis_test(pill_bottle):
     assert 50 < hits < 350  # both outcomes were exercised
 
 
-def test_path_through_the_gap_is_free_everywhere(cube_footprint, wall_checker):
-    path = plan_path(wall_checker, START, GOAL, time_limit=1.0, seed=0)
+@pytest.mark.parametrize("single_turn", [True, False])
+def test_path_through_the_gap_is_free_everywhere(cube_footprint, wall_checker, single_turn):
+    path = plan_path(wall_checker, START, GOAL, time_limit=1.0, seed=0, single_turn=single_turn)
     assert path.shape[1] == 3 and len(path) >= 2
     assert np.allclose(path[0], START)
     assert np.allclose(path[-1, :2], GOAL[:2])
@@ -137,15 +138,60 @@ def test_path_through_the_gap_is_free_everywhere(cube_footprint, wall_checker):
     assert path_length(path) > path_length(np.array([START, GOAL])) + 0.2  # the detour through the gap
 
 
-def test_same_seed_same_path(wall_checker):
-    a = plan_path(wall_checker, START, GOAL, seed=3)
-    b = plan_path(wall_checker, START, GOAL, seed=3)
+def test_where_the_straight_way_is_free_the_path_is_straight_with_one_turn(cube_footprint):
+    """Open table: one turn in place, then a straight line (the fewest spins); next to a block that leaves no room
+    to turn at the start, straight first and the turn at the goal."""
+    open_table = FootprintChecker(cube_footprint, (), WORKSPACE)
+    start, goal = (0.4, -0.1, 0.2), (0.65, 0.1, 1.4)
+    path = plan_path(open_table, start, goal, seed=0)
+    turning = np.abs(np.diff(path[:, 2])) > 1e-9
+    moving = np.hypot(*np.diff(path[:, :2], axis=0).T) > 1e-9
+    assert not np.any(turning & moving)  # turns happen in place
+    assert np.all(turning[:int(np.argmax(moving))]) and not np.any(turning[np.argmax(moving):])  # turn, then go
+    assert path[-1, 2] == pytest.approx(1.4) and np.allclose(path[-1, :2], goal[:2])
+    d = path[:, :2] - np.array(start[:2])
+    u = np.subtract(goal[:2], start[:2]) / np.hypot(*np.subtract(goal[:2], start[:2]))
+    assert np.abs(d[:, 0] * u[1] - d[:, 1] * u[0]).max() < 1e-9  # on the straight line
+
+    # a block beside the start: the square cannot turn there by 45 deg, but can at the goal
+    block = (ap.Box(center=(0.4, 0.0), size=(0.06, 0.06, 0.08)),)
+    checker = FootprintChecker(cube_footprint, block, WORKSPACE)
+    start, goal = (0.4, -0.095, 0.0), (0.65, -0.095, math.pi / 4)
+    assert not checker.is_free(0.4, -0.095, math.pi / 4)
+    path = plan_path(checker, start, goal, seed=0)
+    turning = np.abs(np.diff(path[:, 2])) > 1e-9
+    assert np.allclose(path[:, 1], -0.095) and not np.any(turning[:-9]) and np.all(turning[-9:])
+
+
+def test_a_path_through_a_wide_gap_turns_once(cube_footprint):
+    """The sampled way round a wall with a 30 cm gap keeps one yaw (the cube fits the gap at any), turning once,
+    in place."""
+    gap = 0.3
+    wall = (ap.Box(center=(WALL_X, -(gap / 2 + 0.11)), size=(0.03, 0.22, 0.1)),
+            ap.Box(center=(WALL_X, gap / 2 + 0.11), size=(0.03, 0.22, 0.1)))
+    wall_checker = FootprintChecker(cube_footprint, wall, WORKSPACE)
+    start, goal = (0.4, 0.15, 0.0), (0.65, 0.15, 1.0)
+    path = plan_path(wall_checker, start, goal, seed=0)
+    turning = np.abs(np.diff(path[:, 2])) > 1e-9
+    moving = np.hypot(*np.diff(path[:, :2], axis=0).T) > 1e-9
+    assert not np.any(turning & moving)
+    changes = np.flatnonzero(np.diff(turning.astype(int)))
+    assert len(changes) <= 2  # one contiguous turn, at the start or at the end
+    assert path_length(path) > path_length(np.array([start, goal])) + 0.1  # still round through the gap
+    free = plan_path(wall_checker, start, goal, seed=0, single_turn=False)
+    assert np.abs(np.diff(free[:, 2])).sum() >= np.abs(np.diff(path[:, 2])).sum() - 1e-9
+
+
+@pytest.mark.parametrize("single_turn", [True, False])
+def test_same_seed_same_path(wall_checker, single_turn):
+    a = plan_path(wall_checker, START, GOAL, seed=3, single_turn=single_turn)
+    b = plan_path(wall_checker, START, GOAL, seed=3, single_turn=single_turn)
     assert np.array_equal(a, b)
 
 
 def test_restarts_keep_the_shortest_path(wall_checker):
-    one = plan_path(wall_checker, START, GOAL, seed=4)
-    best = plan_path(wall_checker, START, GOAL, seed=4, attempts=3)
+    one = plan_path(wall_checker, START, GOAL, seed=4, single_turn=False)  # the sampled SE(2) way
+    best = plan_path(wall_checker, START, GOAL, seed=4, attempts=3, single_turn=False)
     assert path_length(best) <= path_length(one) + 1e-9
 
 
