@@ -4,11 +4,18 @@ A push moves the object without turning it (direction: world heading, radians); 
 place. The path is walked in 5 cm strides: before each stride, the yaw the path has reached there is
 caught up with spins (when it is more than ``YAW_DEADBAND`` off), then a push covers the stride. At
 the end, spins bring the object to the goal yaw.
+
+A push moves the object at least ``PUSH_STEP`` (its objective saturates there; the policies move it
+5-9 cm), so a last stride shorter than that would overshoot the goal by the difference, and the
+closed loop would push back and forth across it. A short last stride is therefore covered by two
+full pushes in a V, turned by ``+-acos(stride / (2 PUSH_STEP))`` from it (their sum is the stride),
+on the side where the V's apex is free (``is_free``), else by the one short push.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -33,8 +40,34 @@ def spins_for(dyaw: float) -> list[float]:
 Call = tuple[str, dict, tuple[float, float, float]]  # (skill, params, (x, y, yaw) after)
 
 
-def path_to_calls(path: np.ndarray, goal_yaw: float | None = None) -> list[Call]:
-    """``(skill, params, (x, y, yaw) after)`` calls that track ``path`` ((m, 3) x, y, yaw; metres, radians)."""
+def v_pushes(x: float, y: float, tx: float, ty: float, yaw: float,
+             is_free: Callable[[float, float, float], bool] | None = None) -> list[Call] | None:
+    """Two full pushes from ``(x, y)`` whose sum ends at ``(tx, ty)`` (a stride shorter than ``PUSH_STEP``).
+
+    The V's apex goes on the first side where ``is_free(x, y, yaw)`` holds there and halfway to it on both
+    legs (left first); ``None`` where neither side is free.
+    """
+    stride = math.hypot(tx - x, ty - y)
+    heading = math.atan2(ty - y, tx - x)
+    half = math.acos(min(1.0, stride / (2.0 * PUSH_STEP)))
+    for sign in (1.0, -1.0):
+        first = heading + sign * half
+        ax, ay = x + PUSH_STEP * math.cos(first), y + PUSH_STEP * math.sin(first)
+        probes = ((ax, ay), ((x + ax) / 2, (y + ay) / 2), ((ax + tx) / 2, (ay + ty) / 2))
+        if is_free is None or all(is_free(px, py, yaw) for px, py in probes):
+            second = math.atan2(ty - ay, tx - ax)
+            return [("push", {"direction": float(wrap_angle(first))}, (ax, ay, yaw)),
+                    ("push", {"direction": float(wrap_angle(second))}, (tx, ty, yaw))]
+    return None
+
+
+def path_to_calls(path: np.ndarray, goal_yaw: float | None = None,
+                  is_free: Callable[[float, float, float], bool] | None = None) -> list[Call]:
+    """``(skill, params, (x, y, yaw) after)`` calls that track ``path`` ((m, 3) x, y, yaw; metres, radians).
+
+    ``is_free(x, y, yaw)``: where the object may be (the footprint checker of its resting state); used to place
+    the V of a short last stride (module docstring). Without it, the V goes left.
+    """
     path = np.asarray(path, dtype=float)
     x, y, yaw = path[0]
     calls: list[Call] = []
@@ -50,9 +83,9 @@ def path_to_calls(path: np.ndarray, goal_yaw: float | None = None) -> list[Call]
             calls.append(("spin", {"angle": a}, (x, y, yaw)))
         stride = math.hypot(tx - x, ty - y)
         if stride >= MIN_PUSH or (j == last and stride > 0.0 and not calls):
-            direction = math.atan2(ty - y, tx - x)
+            v = v_pushes(x, y, tx, ty, yaw, is_free) if j == last and stride < PUSH_STEP - 1e-9 else None
+            calls += v or [("push", {"direction": math.atan2(ty - y, tx - x)}, (tx, ty, yaw))]
             x, y = tx, ty
-            calls.append(("push", {"direction": direction}, (x, y, yaw)))
         i = j
     if goal_yaw is not None:
         for a in spins_for(goal_yaw - yaw):

@@ -312,12 +312,14 @@ def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray,
     return None
 
 
-def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *, time_limit: float = 0.1,
-                     seed: int = 0, resolution: float = 0.005) -> np.ndarray | None:
+def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *, iterations: int = 1000,
+                     time_limit: float = 1.0, seed: int = 0, resolution: float = 0.005) -> np.ndarray | None:
     """Positions ``(m, 2)`` from ``start_xy`` to ``goal_xy`` along which the footprint at ``yaw`` stays free, or
-    ``None`` when RRT-Connect (OMPL, in the plane) finds none within ``time_limit`` seconds.
+    ``None`` when RRT-Connect (OMPL, in the plane) finds none within ``iterations`` (or, as a safeguard on a
+    slow machine, ``time_limit`` seconds).
 
-    The waypoints are simplified by OMPL; motions are checked every ``resolution`` metres.
+    An iteration budget, not a time budget, bounds the search, so the same seed gives the same answer however
+    loaded the machine is. The waypoints are simplified by OMPL; motions are checked every ``resolution`` metres.
     """
     if not (checker.is_free(start_xy[0], start_xy[1], yaw) and checker.is_free(goal_xy[0], goal_xy[1], yaw)):
         return None
@@ -344,7 +346,15 @@ def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *
                 state[0], state[1] = float(xy[0]), float(xy[1])
                 ends.append(state)
             setup.setStartAndGoalStates(*ends)
-            result = setup.solve(time_limit)
+            count = [0]
+
+            def spent() -> bool:
+                count[0] += 1
+                return count[0] > iterations
+
+            ptc = ob.plannerOrTerminationCondition(ob.PlannerTerminationCondition(spent),
+                                                   ob.timedPlannerTerminationCondition(time_limit))
+            result = setup.solve(ptc)
             if result.getStatus() != ob.PlannerStatus.EXACT_SOLUTION or not setup.haveExactSolutionPath():
                 return None
             setup.simplifySolution(0.0)  # 0: simplify to the end (no time limit, so deterministic)
@@ -466,8 +476,7 @@ def plan_path(
         if reason is not None:
             raise GoalError(f"{name} {pose} is not free: {reason}")
     if single_turn:
-        path = _turn_once(checker, start, goal, time_limit=min(0.1, time_limit / 4), seed=int(seed),
-                          resolution=resolution)
+        path = _turn_once(checker, start, goal, time_limit=time_limit / 4, seed=int(seed), resolution=resolution)
         if path is not None:
             return path
 

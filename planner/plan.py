@@ -197,7 +197,7 @@ class Planner:
             spot_yaw = self._free_yaw(a, spot, want_yaw)
             path = self._path(a, cur, (*spot, spot_yaw), deadline)
             paths.append((a, path))
-            segment = chain.path_to_calls(path)
+            segment = chain.path_to_calls(path, is_free=self.checkers[a].is_free)
             calls += [(a, *c) for c in segment]
             if segment:
                 cur = segment[-1][2]
@@ -209,7 +209,8 @@ class Planner:
         goal_yaw = goal.yaw if goal.yaw is not None else self._free_yaw(goal_state, goal.xy, cur[2])
         path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
         paths.append((goal_state, path))
-        calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if goal.yaw is not None else None)]
+        calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if goal.yaw is not None else None,
+                                                                 is_free=self.checkers[goal_state].is_free)]
         steps = self._steps(state, (x, y, yaw), calls)
         p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
         self._calls += 1

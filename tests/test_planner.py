@@ -127,6 +127,33 @@ def test_chained_calls_track_the_path():
     assert math.hypot(x - 0.5, y - 0.1) < 0.01 and abs(yaw - math.radians(-30)) <= chain.YAW_DEADBAND
 
 
+def test_a_short_last_stride_is_two_full_pushes_in_a_v():
+    """Pushes move at least PUSH_STEP: 3.5 cm to go is two 5 cm pushes whose sum is the stride, on the free side."""
+    path = np.array([[0.6, 0.0, 0.3], [0.635, 0.0, 0.3]])
+    step = skill_params.PUSH_STEP
+
+    def legs(calls):
+        pts = [(0.6, 0.0)] + [c[2][:2] for c in calls]
+        return [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(pts, pts[1:])], pts
+
+    calls = chain.path_to_calls(path)
+    lengths, pts = legs(calls)
+    assert [c[0] for c in calls] == ["push", "push"] and np.allclose(lengths, step)
+    assert np.allclose(pts[-1], (0.635, 0.0)) and pts[1][1] > 0  # left first
+    for skill, params, after in calls:
+        assert after[2] == 0.3  # pushes do not turn
+
+    right = chain.path_to_calls(path, is_free=lambda x, y, yaw: y <= 0.001)  # nothing free on the left
+    lengths, pts = legs(right)
+    assert np.allclose(lengths, step) and pts[1][1] < 0 and np.allclose(pts[-1], (0.635, 0.0))
+
+    boxed_in = chain.path_to_calls(path, is_free=lambda x, y, yaw: abs(y) < 0.001)  # a 2 mm corridor
+    assert len(boxed_in) == 1 and math.isclose(boxed_in[0][1]["direction"], 0.0, abs_tol=1e-12)
+    long = chain.path_to_calls(np.array([[0.6, 0.0, 0.0], [0.65, 0.0, 0.0], [0.67, 0.0, 0.0]]))  # 5 cm, then 2 cm
+    assert len(long) == 3 and long[0][1]["direction"] == 0.0 and np.allclose(long[0][2][:2], (0.65, 0.0))
+    assert np.allclose(long[-1][2][:2], (0.67, 0.0))  # the last 2 cm as a V
+
+
 def test_forced_failure_replans_without_repeating_the_failed_step():
     cube = ap.load_object("cube")
     direct = skill_params.roll_targets(cube, 0)[0]
