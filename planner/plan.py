@@ -15,7 +15,8 @@
 
 Failures reported back (:meth:`Planner.record_failure`) down-weight what failed: a roll edge in the
 graph, or a push direction (relative to the object) / spin sense in a resting state, which the next
-plan then avoids (a push is split into two pushes 35 deg to either side).
+plan then avoids (a push is split into two pushes 35 deg to either side); a place where rolls failed
+twice is not rolled at again (the object is pushed to the nearest other room first).
 """
 
 from __future__ import annotations
@@ -53,6 +54,11 @@ TURN_BEFORE_MARGIN = 0.15
 # it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
 # rolls back (when the two rolls and a spin there are likelier than a spin in the goal state).
 SPIN_DETOUR_BELOW = 0.3
+# A place where rolls failed this often (any target; within ROLL_SPOT_RADIUS metres) is not rolled at again:
+# some spots defeat every roll (the arm cannot reach round the object there), and trying each target in
+# turn at the same spot spent whole executions.
+ROLL_SPOT_FAILURES = 2
+ROLL_SPOT_RADIUS = 0.04
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 
@@ -131,6 +137,7 @@ class Planner:
         self.clearance = clearance
         self.roll_margin = roll_margin
         self.failures: Counter = Counter()
+        self.failed_roll_spots: list[tuple[float, float]] = []  # (x, y) of every failed roll, metres
         self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
         self.footprints = inflated_footprints(obj, clearance)
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
@@ -147,8 +154,10 @@ class Planner:
         """Remember a failed call; returns how often that (state, skill, parameter) has failed."""
         key = failure_key(self.obj, skill, params, T_world_object)
         self.failures[key] += 1
-        if skill == "roll" and self.failures[key] >= FAILURES_TO_AVOID:
-            self.graph.penalise(key[0], params["target"])
+        if skill == "roll":
+            self.failed_roll_spots.append((float(T_world_object[0, 3]), float(T_world_object[1, 3])))
+            if self.failures[key] >= FAILURES_TO_AVOID:
+                self.graph.penalise(key[0], params["target"])
         return self.failures[key]
 
     def _failed(self, skill: str, params: dict, T: np.ndarray) -> int:
@@ -351,15 +360,21 @@ class Planner:
                 return spot
         raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
 
+    def _spoiled(self, x: float, y: float) -> bool:
+        """Whether rolls failed :data:`ROLL_SPOT_FAILURES` times within :data:`ROLL_SPOT_RADIUS` of (x, y)."""
+        near = sum(math.hypot(x - fx, y - fy) <= ROLL_SPOT_RADIUS for fx, fy in self.failed_roll_spots)
+        return near >= ROLL_SPOT_FAILURES
+
     def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal) -> tuple[float, float] | None:
-        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur):
+        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self._spoiled(*cur[:2]):
             return float(cur[0]), float(cur[1])
         ws = self.workspace
         best, best_cost = None, math.inf
         for px in np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01):
             for py in np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01):
                 cost = math.hypot(px - cur[0], py - cur[1]) + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1])
-                if cost < best_cost and room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]):
+                if cost < best_cost and room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]) \
+                        and not self._spoiled(px, py):
                     best, best_cost = (float(px), float(py)), cost
         return best
 

@@ -173,6 +173,38 @@ def test_forced_failure_replans_without_repeating_the_failed_step():
     assert cube.classify(ex.final_pose) == direct
 
 
+class RollsFailNear(IdealSkill):
+    """Rolls that fail (leaving the object where it is) within 3 cm of one place."""
+
+    def __init__(self, xy):
+        super().__init__("roll")
+        self.xy, self.where = xy, []
+
+    def execute(self, sim, params):
+        T0 = sim.object_pose()
+        self.where.append((float(T0[0, 3]), float(T0[1, 3])))
+        self.fail = lambda p, state: math.hypot(T0[0, 3] - self.xy[0], T0[1, 3] - self.xy[1]) < 0.03
+        return super().execute(sim, params)
+
+
+def test_a_place_where_rolls_failed_twice_is_left_for_another():
+    cube = ap.load_object("cube")
+    target = skill_params.roll_targets(cube, 0)[0]
+    skills = {n: IdealSkill(n) for n in ("push", "spin")}
+    skills["roll"] = RollsFailNear((0.45, 0.0))
+    planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    goal = ap.Goal(xy=(0.45, 0.0), resting_state=target)  # the goal is where rolls fail
+    plan = planner.plan(cube.resting_states[0].pose((0.45, 0.0), 0.0), goal)
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=20)
+    assert ex.success, str(ex)
+    where = skills["roll"].where
+    at_bad = [w for w in where if math.hypot(w[0] - 0.45, w[1]) < 0.03]
+    assert len(at_bad) == 2  # two failures there, then the roll moved elsewhere
+    assert math.hypot(where[-1][0] - 0.45, where[-1][1]) > 0.04
+
+
 def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
     """Pushes towards the goal fail, and so does one side of the detour round them: neither is tried a third time.
 
