@@ -290,12 +290,12 @@ def _free_along(checker: FootprintChecker, path: np.ndarray, resolution: float) 
     return all(checker.is_free(*pose) for pose in interpolate_path(path, resolution, math.radians(2.0)))
 
 
-def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray,
-                     resolution: float = 0.005) -> np.ndarray | None:
+def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray, resolution: float = 0.005,
+                     turn_first: bool = True) -> np.ndarray | None:
     """``waypoints``' positions at one held yaw with a single turn in place, when that stays free; else ``None``.
 
-    Tried in order: turn at the first waypoint to the last one's yaw and hold it, or hold the first one's yaw
-    and turn at the last waypoint. Every executed turn is a spin, which moves objects sideways by centimetres,
+    Tried in order (``turn_first``; else the other way round): turn at the first waypoint to the last one's yaw
+    and hold it, or hold the first one's yaw and turn at the last waypoint. Every executed turn is a spin, which moves objects sideways by centimetres,
     and every change of heading along a sampled path is one more: where one turn will do, this is the path
     with fewest spins. Checked every ``resolution`` metres and every 2 deg; returned densified like
     :func:`plan_path`'s paths.
@@ -304,7 +304,7 @@ def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray,
     (x0, y0, a0), (x1, y1, a1) = waypoints[0], waypoints[-1]
     a1 = a0 + wrap_angle(a1 - a0)
     xy = waypoints[:, :2]
-    for held in (a1, a0):
+    for held in ((a1, a0) if turn_first else (a0, a1)):
         path = np.column_stack([xy, np.full(len(xy), held)])
         path = np.vstack([[x0, y0, a0], path]) if held == a1 else np.vstack([path, [x1, y1, a1]])
         if _free_along(checker, path, resolution):
@@ -368,18 +368,18 @@ def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *
 
 
 def _turn_once(checker: FootprintChecker, start, goal, *, time_limit: float, seed: int,
-               resolution: float) -> np.ndarray | None:
+               resolution: float, turn_first: bool = True) -> np.ndarray | None:
     """A path that turns once, in place, at the start or at the goal, and moves at one held yaw (or ``None``).
 
     The straight way first (:func:`single_turn_path`), then a plane path at the goal's yaw after turning at
     the start, then one at the start's yaw before turning at the goal (:func:`plan_at_held_yaw`).
     """
-    path = single_turn_path(checker, np.array([start, goal], dtype=float), resolution)
+    path = single_turn_path(checker, np.array([start, goal], dtype=float), resolution, turn_first)
     if path is not None:
         return path
     (x0, y0, a0), (x1, y1, a1) = start, goal
     a1 = a0 + wrap_angle(a1 - a0)
-    for held in dict.fromkeys((a1, a0)):  # turn at the start, or at the goal
+    for held in dict.fromkeys((a1, a0) if turn_first else (a0, a1)):  # turn at the start, or at the goal
         xy = plan_at_held_yaw(checker, (x0, y0), (x1, y1), held, time_limit=time_limit, seed=seed,
                               resolution=resolution)
         if xy is None:
@@ -424,6 +424,7 @@ def plan_path(
     yaw_weight: float = 0.05,
     attempts: int = 1,
     single_turn: bool = True,
+    turn_first: bool = True,
 ) -> np.ndarray:
     """Collision-free SE(2) path of the checker's footprint from ``start`` to ``goal``.
 
@@ -450,6 +451,7 @@ def plan_path(
         yaw_weight: metres that one radian of yaw counts for in the SE(2) metric.
         attempts: independent RRT-Connect runs; the shortest exact solution is returned.
         single_turn: prefer paths that turn once (:func:`single_turn_path`).
+        turn_first: with ``single_turn``, try turning at the start before turning at the goal.
 
     Returns:
         (n, 3) array of (x, y, yaw), world frame; ``path[0] == start``; yaw is continuous
@@ -476,7 +478,8 @@ def plan_path(
         if reason is not None:
             raise GoalError(f"{name} {pose} is not free: {reason}")
     if single_turn:
-        path = _turn_once(checker, start, goal, time_limit=time_limit / 4, seed=int(seed), resolution=resolution)
+        path = _turn_once(checker, start, goal, time_limit=time_limit / 4, seed=int(seed), resolution=resolution,
+                          turn_first=turn_first)
         if path is not None:
             return path
 
@@ -516,7 +519,7 @@ def plan_path(
     waypoints[0] = (start[0], start[1], wrap_angle(start[2]))
     waypoints[-1] = (goal[0], goal[1], wrap_angle(goal[2]))
     if single_turn:  # the sampled way, turning once
-        path = single_turn_path(checker, waypoints, resolution)
+        path = single_turn_path(checker, waypoints, resolution, turn_first)
         if path is not None:
             return path
     waypoints[:, 2] = np.unwrap(waypoints[:, 2]) + (start[2] - waypoints[0, 2])  # continuous from start's yaw

@@ -324,7 +324,22 @@ class Planner:
         if left <= 0:
             raise PlanningError(f"planning ran out of its {self.time_limit:.1f} s before reaching the goal")
         return plan_path(self.checkers[state], tuple(start), tuple(goal), time_limit=min(left, 1.0),
-                         seed=self.seed + self._calls, attempts=2)
+                         seed=self.seed + self._calls, attempts=2, turn_first=self._turn_first(state, start, goal))
+
+    def _turn_first(self, state: int, start, goal) -> bool:
+        """Whether to turn before moving (push at the goal's yaw) rather than after (push at the start's yaw).
+
+        Paths turn once (:func:`planner.motion.single_turn_path`); the pushes between then all push the same
+        way relative to the object, so the yaw they push it at is the one whose push towards the goal the
+        success model rates likelier (a box pushed square to a face, not on a corner).
+        """
+        heading = math.atan2(goal[1] - start[1], goal[0] - start[0])
+        if math.hypot(goal[1] - start[1], goal[0] - start[0]) < 1e-6 or abs(wrap_angle(goal[2] - start[2])) < 1e-6:
+            return True
+        p_start, p_goal = self.predictor.p_success_many(
+            [("push", {"direction": heading}, state_pose(self.obj, state, start[0], start[1], yaw))
+             for yaw in (start[2], goal[2])])
+        return bool(p_goal >= p_start)
 
     def _free_yaw(self, state: int, xy, prefer: float) -> float:
         checker = self.checkers[state]

@@ -317,6 +317,33 @@ def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn()
     assert plan.route == [0]
 
 
+class PushesSquareOnly(StubPredictor):
+    """Rates pushes 0.9 where the object's yaw is a multiple of 90 deg (within 5 deg), 0.1 elsewhere."""
+
+    def __init__(self, skills, obj):
+        super().__init__(skills)
+        self.obj = obj
+
+    def p_success_many(self, queries):
+        def square(T):
+            yaw = self.obj.planar_pose(T)[3]
+            return abs(wrap_angle(4 * yaw)) < math.radians(20)
+        return np.array([(0.9 if square(T) else 0.1) if skill == "push" else self.p for skill, _, T in queries])
+
+
+def test_pushes_happen_at_the_yaw_where_they_are_rated_likelier():
+    """One turn per path: before the pushes when they work better at the goal's yaw, after them otherwise."""
+    cube = ap.load_object("cube")
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    planner = Planner(cube, (), predictor=PushesSquareOnly(skills, cube), time_limit=5.0, seed=0)
+    for start_yaw, goal_yaw in ((0.0, math.radians(40)), (math.radians(40), 0.0)):
+        plan = planner.plan(cube.resting_states[0].pose((0.45, 0.0), start_yaw),
+                            ap.Goal(xy=(0.62, 0.03), yaw=goal_yaw, resting_state=0))
+        pushes = [s for s in plan.steps if s.skill == "push"]
+        assert pushes and all(abs(wrap_angle(cube.planar_pose(s.start_pose)[3])) < math.radians(11) for s in pushes)
+        assert all(s.p_success > 0.5 for s in pushes)
+
+
 def test_bad_goals_raise_their_errors():
     cube = ap.load_object("cube")
     planner = _planner(cube, WALL_WITH_GAP)
