@@ -295,10 +295,10 @@ def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray, resolutio
     """``waypoints``' positions at one held yaw with a single turn in place, when that stays free; else ``None``.
 
     Tried in order (``turn_first``; else the other way round): turn at the first waypoint to the last one's yaw
-    and hold it, or hold the first one's yaw and turn at the last waypoint. Every executed turn is a spin, which moves objects sideways by centimetres,
-    and every change of heading along a sampled path is one more: where one turn will do, this is the path
-    with fewest spins. Checked every ``resolution`` metres and every 2 deg; returned densified like
-    :func:`plan_path`'s paths.
+    and hold it, or hold the first one's yaw and turn at the last waypoint. Every executed turn is a spin,
+    which moves objects sideways by centimetres, and every change of heading along a sampled path is one
+    more: where one turn will do, this is the path with fewest spins. Checked every ``resolution`` metres
+    and every 2 deg; returned densified like :func:`plan_path`'s paths.
     """
     waypoints = np.asarray(waypoints, dtype=float)
     (x0, y0, a0), (x1, y1, a1) = waypoints[0], waypoints[-1]

@@ -15,8 +15,8 @@ goal flow. No centre of mass, no dense cloud:
 - **direction**: +x of the goal frame when a direction is asked (the flow is non-zero), otherwise a
   uniformly drawn yaw (the seed's objective takes any direction);
 - **contact**: among points whose normal faces against the push by more than 60 deg, in a height band
-  drawn at random (the lower 70 % of the cloud's height: higher contacts tip objects), one of the ``NEAREST`` nearest to the line through
-  the cloud's horizontal centre along the push;
+  drawn at random (the lower 70 % of the cloud's height: higher contacts tip objects), one of the
+  ``NEAREST`` nearest to the line through the cloud's horizontal centre along the push;
 - **motion**: along the push, a stroke of 0.6-1.0 of the full one, pressing down by 0-0.5.
 """
 

@@ -351,7 +351,8 @@ def main(argv: list[str] | None = None) -> int:
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
         checkpoint_minutes=args.checkpoint_minutes, n_points=args.n_points, torch_threads=args.torch_threads,
-        p_params=args.p_params, p_scripted=args.p_scripted, init=args.init, weight_sync_updates=args.weight_sync_updates,
+        p_params=args.p_params, p_scripted=args.p_scripted, init=args.init,
+        weight_sync_updates=args.weight_sync_updates,
     )
     try:
         check_config(cfg)

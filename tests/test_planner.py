@@ -140,8 +140,7 @@ def test_a_short_last_stride_is_two_full_pushes_in_a_v():
     lengths, pts = legs(calls)
     assert [c[0] for c in calls] == ["push", "push"] and np.allclose(lengths, step)
     assert np.allclose(pts[-1], (0.635, 0.0)) and pts[1][1] > 0  # left first
-    for skill, params, after in calls:
-        assert after[2] == 0.3  # pushes do not turn
+    assert all(after[2] == 0.3 for _, _, after in calls)  # pushes do not turn
 
     right = chain.path_to_calls(path, is_free=lambda x, y, yaw: y <= 0.001)  # nothing free on the left
     lengths, pts = legs(right)
