@@ -44,10 +44,10 @@ from affordplan.sim.simulator import Simulator
 from primitives import rewards
 from primitives.env import PrimitiveEnv
 from primitives.evaluate import greedy_action, held_out_config, load_policy
+from primitives.scripted import facing_and_offset
 
 CLOUD_POINTS = 2048
 HEIGHT_BANDS = ((0.05, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.95))  # fractions of the object's height
-FACING_COS = -0.5  # normal . push < this: the surface faces the push (by more than 60 deg)
 CANDIDATES = 64  # per start, at most (fewer where a height band has no facing points)
 
 
@@ -67,9 +67,7 @@ def push_candidates(points: np.ndarray, normals: np.ndarray, com: np.ndarray, di
     and press (downward motion component).
     """
     d = np.array([math.cos(direction), math.sin(direction), 0.0])
-    facing = normals @ d < FACING_COS
-    rel = points - com
-    lateral = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0])  # distance from the push line through the COM
+    facing, lateral = facing_and_offset(points, normals, com, d)  # lateral: from the push line through the COM
     z0, z1 = points[:, 2].min(), points[:, 2].max()
     out = []
     for lo, hi in HEIGHT_BANDS:

@@ -33,16 +33,23 @@ STROKE = (0.6, 1.0)  # fraction of the full stroke along the push
 PRESS = (0.0, 0.5)  # downward motion component
 
 
+def facing_and_offset(points: np.ndarray, normals: np.ndarray, centre: np.ndarray,
+                      d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For a push along the horizontal unit vector ``d``: which points face it (normal against it by more than
+    60 deg), and each point's horizontal distance from the push line through ``centre`` (metres)."""
+    rel = points - centre
+    return normals @ d < FACING_COS, np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0])
+
+
 def scripted_push(obs: np.ndarray, rng: np.random.Generator) -> tuple[int, np.ndarray]:
     """A scripted push for a goal-frame observation ``(n, 9)``: contact index and goal-frame motion in [-1, 1]^3."""
     obs = np.asarray(obs, dtype=np.float64)
     points, normals, flow = obs[:, :3], obs[:, 3:6], obs[:, 6:9]
     yaw = 0.0 if np.abs(flow).max() > 0 else rng.uniform(-math.pi, math.pi)
     d = np.array([math.cos(yaw), math.sin(yaw), 0.0])
-    facing = normals @ d < FACING_COS
+    facing, lateral = facing_and_offset(points, normals, np.zeros(3), d)  # the cloud is centred horizontally
     if not facing.any():  # degenerate cloud: the point furthest against the push
         facing = points @ d <= (points @ d).min() + 1e-9
-    lateral = np.abs(points[:, 0] * d[1] - points[:, 1] * d[0])  # the cloud is centred horizontally
     z0, z1 = points[:, 2].min(), points[:, 2].max()
     lo, hi = HEIGHT_BANDS[int(rng.integers(len(HEIGHT_BANDS)))]
     band = facing & (points[:, 2] >= z0 + lo * (z1 - z0)) & (points[:, 2] <= z0 + hi * (z1 - z0))
