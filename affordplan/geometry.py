@@ -66,6 +66,13 @@ def wrap_angle(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
+def wrap_period(a: float, period: float) -> float:
+    """Wrap an angle to ``[-period / 2, period / 2)`` (radians; a ``period`` of ``2 pi`` is :func:`wrap_angle`)."""
+    if period >= 2.0 * math.pi - 1e-12:
+        return wrap_angle(a)
+    return (a + 0.5 * period) % period - 0.5 * period
+
+
 def transform_points(T: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Apply a 4x4 pose to (n, 3) points."""
     return points @ T[:3, :3].T + T[:3, 3]

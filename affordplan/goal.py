@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from affordplan.errors import GoalError
-from affordplan.geometry import wrap_angle
+from affordplan.geometry import wrap_period
 from affordplan.objects.model import ObjectModel
 
 
@@ -23,6 +23,11 @@ class Goal:
         resting_state: index into ``obj.resting_states``; ``None``: any (the start's is kept).
         xy_tol: reached when the centre is within this distance, metres.
         yaw_tol: and the yaw within this angle, radians.
+        yaw_symmetric: compare yaws modulo the resting state's symmetry about the vertical
+            (:meth:`ObjectModel.yaw_period`): a cube on a face at yaw 90 deg is the same solid in the same place
+            as at 0, an upright 32-facet cylinder at any yaw is within 5.6 deg of every other. ``False`` when
+            the object's markings tell those poses apart (a die's pips, a labelled box): then the yaw is the
+            frame's.
     """
 
     xy: tuple[float, float]
@@ -30,6 +35,7 @@ class Goal:
     resting_state: int | None = None
     xy_tol: float = 0.03
     yaw_tol: float = math.radians(15.0)
+    yaw_symmetric: bool = True
 
     def __post_init__(self):
         try:
@@ -46,6 +52,9 @@ class Goal:
         if self.resting_state is not None and (
                 not isinstance(self.resting_state, (int, np.integer)) or isinstance(self.resting_state, bool)):
             raise GoalError(f"goal resting_state must be an integer index or None, got {self.resting_state!r}")
+        if not isinstance(self.yaw_symmetric, (bool, np.bool_)):
+            raise GoalError(f"goal yaw_symmetric must be True or False, got {self.yaw_symmetric!r}")
+        object.__setattr__(self, "yaw_symmetric", bool(self.yaw_symmetric))
         for name in ("xy_tol", "yaw_tol"):
             v = getattr(self, name)
             if not isinstance(v, (int, float, np.floating)) or not math.isfinite(v) or v <= 0:
@@ -58,13 +67,35 @@ class Goal:
             raise GoalError(f"goal resting_state {self.resting_state} does not exist: {obj.name} has {n} resting "
                             f"states (0..{n - 1})")
 
+    def period(self, obj: ObjectModel, state: int) -> float:
+        """Radians by which yaws in ``state`` are equal for this goal: the state's symmetry, or ``2 pi``."""
+        return obj.yaw_period(state) if self.yaw_symmetric else 2.0 * math.pi
+
+    def yaw_near(self, obj: ObjectModel, state: int, yaw: float) -> float | None:
+        """Of the yaws in ``state`` that meet this goal's yaw exactly, the one nearest ``yaw`` (radians); ``None``
+        without a goal yaw."""
+        if self.yaw is None:
+            return None
+        period = self.period(obj, state)
+        return float(yaw - wrap_period(yaw - self.yaw, period))
+
+    def yaw_error(self, obj: ObjectModel, state: int, yaw: float) -> float:
+        """``|yaw error|`` (radians) of a pose of ``state`` at ``yaw``; 0 without a goal yaw."""
+        if self.yaw is None:
+            return 0.0
+        return abs(wrap_period(yaw - self.yaw, self.period(obj, state)))
+
+    def yaw_free(self, obj: ObjectModel, state: int) -> bool:
+        """Whether every yaw of ``state`` meets the goal (no goal yaw, or symmetry finer than twice the tolerance)."""
+        return self.yaw is None or self.period(obj, state) <= 2.0 * self.yaw_tol
+
     def errors(self, obj: ObjectModel, T_world_object: np.ndarray) -> tuple[float, float, bool]:
         """``(xy distance in metres, |yaw error| in radians (0 without a goal yaw), state matches)``."""
         state, x, y, yaw = obj.planar_pose(T_world_object)
         d = float(np.hypot(x - self.xy[0], y - self.xy[1]))
-        yaw_err = 0.0 if self.yaw is None else abs(wrap_angle(yaw - self.yaw))
-        return d, yaw_err, self.resting_state is None or state == self.resting_state
+        return d, self.yaw_error(obj, state, yaw), self.resting_state is None or state == self.resting_state
 
     def reached(self, obj: ObjectModel, T_world_object: np.ndarray) -> bool:
         d, yaw_err, state_ok = self.errors(obj, T_world_object)
         return state_ok and d <= self.xy_tol and yaw_err <= self.yaw_tol
+

@@ -12,7 +12,8 @@ field whose name ends in ``_deg`` (give one or the other, not both)::
       "size": 0.05,                                         # optional: largest half-extent, metres
       "start": {"resting_state": 0, "xy": [0.45, -0.05], "yaw": 0.5},
       "goal": {"xy": [0.69, 0.0], "resting_state": 1, "yaw_deg": 90,
-               "xy_tol": 0.03, "yaw_tol_deg": 15},           # yaw, resting_state, tolerances optional
+               "xy_tol": 0.03, "yaw_tol_deg": 15,            # yaw, resting_state, tolerances optional
+               "yaw_symmetric": true},                        # optional: false when markings break symmetry
       "obstacles": [{"center": [0.6, -0.21], "size": [0.02, 0.2, 0.1], "yaw": 0.0}]
     }
 
@@ -38,7 +39,7 @@ from affordplan.world import Box
 
 TOP_LEVEL = ("name", "description", "object", "size", "start", "goal", "obstacles")
 START_FIELDS = ("resting_state", "xy", "yaw", "yaw_deg")
-GOAL_FIELDS = ("xy", "yaw", "yaw_deg", "resting_state", "xy_tol", "yaw_tol", "yaw_tol_deg")
+GOAL_FIELDS = ("xy", "yaw", "yaw_deg", "resting_state", "xy_tol", "yaw_tol", "yaw_tol_deg", "yaw_symmetric")
 BOX_FIELDS = ("center", "size", "yaw", "yaw_deg")
 
 # The README's main job: the mug lies on its side behind a wall with a 22 cm gap; the plan flips it
@@ -99,7 +100,7 @@ class Scene:
         """The scene as plain data (radians), in the file format."""
         g = self.goal
         goal = {"xy": list(g.xy), "resting_state": g.resting_state, "yaw": g.yaw, "xy_tol": g.xy_tol,
-                "yaw_tol": g.yaw_tol}
+                "yaw_tol": g.yaw_tol, "yaw_symmetric": g.yaw_symmetric}
         return {
             "name": self.name, "description": self.description, "object": self.object, "size": self.size,
             "start": {"resting_state": self.start["resting_state"], "xy": list(self.start["xy"]),
@@ -251,6 +252,10 @@ def _goal(value: Any, source: str) -> Goal:
     tol = _angle(d, "yaw_tol", source, "goal", None)
     if tol is not None:
         kwargs["yaw_tol"] = _number(tol, source, "goal.yaw_tol", positive=True)
+    if "yaw_symmetric" in d:
+        if not isinstance(d["yaw_symmetric"], bool):
+            raise InputError(f"{source}: goal.yaw_symmetric must be true or false, got {d['yaw_symmetric']!r}")
+        kwargs["yaw_symmetric"] = d["yaw_symmetric"]
     try:
         return Goal(**kwargs)
     except AffordplanError as exc:

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from affordplan.errors import AffordplanError
-from affordplan.geometry import wrap_angle
+from affordplan.geometry import wrap_angle, wrap_period
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
@@ -97,10 +97,12 @@ def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int)
     return s
 
 
-def _off_plan(obj: ObjectModel, T: np.ndarray, T_expected: np.ndarray) -> bool:
+def _off_plan(obj: ObjectModel, goal: Goal, T: np.ndarray, T_expected: np.ndarray) -> bool:
+    """Whether ``T`` is off the expected pose (yaws compared modulo the state's symmetry, as the goal does)."""
     s, x, y, yaw = obj.planar_pose(T)
     se, xe, ye, yawe = obj.planar_pose(T_expected)
-    return s != se or math.hypot(x - xe, y - ye) > XY_TOL or abs(wrap_angle(yaw - yawe)) > YAW_TOL
+    turn = wrap_period(yaw - yawe, goal.period(obj, s))
+    return s != se or math.hypot(x - xe, y - ye) > XY_TOL or abs(turn) > YAW_TOL
 
 
 def _frame(sim: Simulator, render) -> np.ndarray | None:
@@ -180,7 +182,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         if n == max_primitives:
             break
         replanned = False
-        if k >= len(steps) or _off_plan(obj, T, steps[k].start_pose):
+        if k >= len(steps) or _off_plan(obj, goal, T, steps[k].start_pose):
             try:
                 new = planner.plan(T, goal)
             except AffordplanError as exc:  # PlanningError, GoalError, ...

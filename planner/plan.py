@@ -174,7 +174,11 @@ class Planner:
         if not self.workspace.contains(goal.xy):
             raise GoalError(f"goal xy={goal.xy} is outside the workspace {self.workspace}")
         checker = self.checkers[state]
-        yaws = [goal.yaw] if goal.yaw is not None else list(np.linspace(-math.pi, math.pi, 12, endpoint=False))
+        if goal.yaw_free(self.obj, state):
+            yaws = list(np.linspace(-math.pi, math.pi, 12, endpoint=False))
+        else:  # the goal's yaw and the yaws its state's symmetry makes equal to it
+            period = goal.period(self.obj, state)
+            yaws = [goal.yaw + k * period for k in range(int(round(2.0 * math.pi / period)))]
         if not any(checker.is_free(*goal.xy, a) for a in yaws):
             why = checker.why_not_free(*goal.xy, yaws[0])
             raise GoalError(f"goal xy={goal.xy} is not reachable by the object in resting state {state}: {why}")
@@ -187,8 +191,9 @@ class Planner:
         deadline = t0 + self.time_limit
         state, x, y, yaw = self.obj.planar_pose(T_start)
         goal_state = self.check_goal(goal, state)
+        turn = not goal.yaw_free(self.obj, goal_state)  # whether the goal's yaw asks for anything
         route = self.graph.route(state, goal_state)
-        if goal.yaw is not None:
+        if turn:
             route = self._route_to_turn(route, yaw, goal)
         calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
         paths: list[tuple[int, np.ndarray]] = []
@@ -201,8 +206,8 @@ class Planner:
             spot = self._roll_spot(a, b, cur, goal)
             want_yaw = cur[2]
             last_roll = k == len(route) - 2
-            if goal.yaw is not None and last_roll and self._turns_better(a, goal_state):
-                want_yaw = self._yaw_before_roll(a, b, spot, goal.yaw)  # turn here, arrive turned
+            if turn and last_roll and self._turns_better(a, goal_state):
+                want_yaw = self._yaw_before_roll(a, b, spot, goal, cur[2])  # turn here, arrive turned
             spot_yaw = self._free_yaw(a, spot, want_yaw)
             path = self._path(a, cur, (*spot, spot_yaw), deadline)
             paths.append((a, path))
@@ -215,10 +220,10 @@ class Planner:
             _, ax, ay, ayaw = self.obj.planar_pose(T_after)
             calls.append((a, "roll", {"target": b}, (ax, ay, ayaw)))
             cur = (ax, ay, ayaw)
-        goal_yaw = goal.yaw if goal.yaw is not None else self._free_yaw(goal_state, goal.xy, cur[2])
+        goal_yaw = goal.yaw_near(self.obj, goal_state, cur[2]) if turn else self._free_yaw(goal_state, goal.xy, cur[2])
         path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
         paths.append((goal_state, path))
-        calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if goal.yaw is not None else None,
+        calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if turn else None,
                                                                  is_free=self.checkers[goal_state].is_free)]
         steps = self._steps(state, (x, y, yaw), calls)
         p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
@@ -278,7 +283,7 @@ class Planner:
         ``P(roll g->s) P(spin in s) P(roll s->g)`` beats ``P(spin in g)``.
         """
         g = route[-1]
-        if len(route) == 1 and abs(wrap_angle(goal.yaw - yaw)) <= goal.yaw_tol:
+        if len(route) == 1 and goal.yaw_error(self.obj, g, yaw) <= goal.yaw_tol:
             return route
         if self._spin_rating(g) >= SPIN_DETOUR_BELOW or (len(route) > 1 and self._turns_better(route[-2], g)):
             return route
@@ -291,14 +296,16 @@ class Planner:
                 best, best_p = int(s), p
         return route if best is None else route + [best, g]
 
-    def _yaw_before_roll(self, a: int, b: int, spot, goal_yaw: float) -> float:
-        """Yaw in state ``a`` at ``spot`` from which the roll to ``b`` ends at ``goal_yaw`` (ideally).
+    def _yaw_before_roll(self, a: int, b: int, spot, goal: Goal, yaw: float) -> float:
+        """Yaw in state ``a`` at ``spot`` from which the roll to ``b`` ends at the goal's yaw (ideally); of the
+        yaws the goal takes as equal (:meth:`Goal.yaw_near`), the one the least turn from ``yaw`` reaches.
 
         Rolls are equivariant under turns about the vertical: turning the object by ``d`` before the roll
         turns the rolled pose by ``d``. So one expected roll from yaw 0 gives the offset.
         """
         T_after = expected_pose(self.obj, "roll", {"target": b}, state_pose(self.obj, a, *spot, 0.0))
-        return float(wrap_angle(goal_yaw - self.obj.planar_pose(T_after)[3]))
+        offset = self.obj.planar_pose(T_after)[3]
+        return float(wrap_angle(goal.yaw_near(self.obj, b, yaw + offset) - offset))
 
     def _detour(self, direction: float, T: np.ndarray) -> list[float]:
         """Pushes that stand in for a push along ``direction`` (radians) that failed twice from pose ``T``.

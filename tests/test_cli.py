@@ -37,8 +37,10 @@ def test_yaml_scenes_parse_with_degrees_and_tolerances():
     assert corridor.object == "lunch_box"
     assert corridor.goal.yaw == pytest.approx(math.pi) and corridor.goal.yaw_tol == pytest.approx(math.radians(15))
     assert corridor.start["yaw"] == 0.0 and len(corridor.obstacles) == 2
+    assert not corridor.goal.yaw_symmetric  # the labelled box's two ends differ
     die = load_scene(SCENES / "die_two_blocks.yaml")
     assert die.goal.resting_state == 2 and die.goal.yaw == pytest.approx(math.radians(30))
+    assert not die.goal.yaw_symmetric and load_scene(SCENES / "mug_wall.json").goal.yaw_symmetric  # the default
     # a scene survives a round trip through its plain-data form
     assert parse_scene(json.loads(json.dumps(die.as_dict()))) == die
 
@@ -65,6 +67,7 @@ _DELETE = object()
     (("goal", "yaw"), 1.0, InputError, "give yaw (radians) or yaw_deg (degrees), not both"),
     (("goal", "resting_state"), -1, InputError, "goal.resting_state must be a resting-state index"),
     (("goal", "colour"), "red", InputError, "goal: unknown field(s) ['colour']"),
+    (("goal", "yaw_symmetric"), "no", InputError, "goal.yaw_symmetric must be true or false"),
     (("start", "xy"), _DELETE, InputError, "start: missing field 'xy'"),
     (("start", "resting_state"), 1.5, InputError, "start.resting_state must be a resting-state index"),
     (("obstacles",), {"center": [0.6, 0.0]}, InputError, "obstacles must be a list"),

@@ -2,17 +2,19 @@
 
 from __future__ import annotations
 
+import math
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
+from scipy.spatial.transform import Rotation
 
 import affordplan as ap
 from affordplan.errors import InputError, MeshError
 from affordplan.objects import decompose
-from affordplan.objects.resting import compute_resting_states
+from affordplan.objects.resting import compute_resting_states, yaw_period
 from affordplan.objects.shapes import annular_wedges, frustum, union
 
 DATA = Path(__file__).parent / "data"
@@ -196,6 +198,31 @@ def test_bad_size_raises():
         ap.load_object("cube", size=float("nan"))
     with pytest.raises(InputError):
         ap.load_object("cube", size=-1.0)
+
+
+def test_yaw_period_is_the_smallest_turn_that_maps_the_state_onto_itself(cube, lunch_box, mug):
+    assert [round(math.degrees(cube.yaw_period(i)), 6) for i in range(6)] == [90.0] * 6
+    assert [round(math.degrees(lunch_box.yaw_period(i)), 6) for i in range(6)] == [180.0] * 6
+    assert [math.degrees(mug.yaw_period(i)) for i in range(3)] == [360.0] * 3  # the handle
+    planter = ap.load_object("planter_1")  # 32 facets round: upright either way up, 11.25 deg; lying, none
+    assert sorted(round(math.degrees(planter.yaw_period(i)), 6) for i in range(3)) == [11.25, 11.25, 360.0]
+    # the turn by the period maps the posed mesh onto itself, half of it does not
+    for obj, state in ((lunch_box, 0), (planter, 1)):
+        period, up = obj.yaw_period(state), obj.resting_states[state].up
+        v = obj.mesh.vertices
+        for angle, same in ((period, True), (period / 2, False)):
+            turned = Rotation.from_rotvec(up * angle).apply(v)
+            gap = np.max(np.min(np.linalg.norm(turned[:, None] - v[None], axis=2), axis=1))
+            assert (gap < 1e-4) == same
+
+
+def test_a_scanned_mesh_has_no_symmetry():
+    rng = np.random.default_rng(0)
+    box = trimesh.creation.box((0.05, 0.05, 0.05))
+    box.vertices += rng.normal(0.0, 1e-3, box.vertices.shape)  # scanner noise: vertices no longer coincide
+    assert yaw_period(box.vertices, np.array([0.0, 0.0, 1.0])) == pytest.approx(2 * math.pi)
+    assert yaw_period(trimesh.creation.box((0.05, 0.05, 0.05)).vertices, np.array([0.0, 0.0, 1.0])) == \
+        pytest.approx(math.pi / 2)
 
 
 def test_tied_resting_states_are_ordered_by_up_vector_not_by_rounding_noise(cube):

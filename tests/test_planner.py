@@ -263,7 +263,8 @@ def test_a_goal_yaw_is_reached_before_the_roll_where_the_goal_state_does_not_spi
     cube = ap.load_object("cube")
     target = skill_params.roll_targets(cube, 0)[0]
     skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
-    goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(100.0), resting_state=target)
+    # a labelled cube: without markings, 100 deg would be 10 deg (yaw_symmetric, tested below)
+    goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(100.0), resting_state=target, yaw_symmetric=False)
     T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
 
     def spin_states(predictor):
@@ -291,7 +292,7 @@ def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn()
     """Start and goal share a resting state that the success model says cannot be spun: roll away, turn, roll back."""
     cube = ap.load_object("cube")
     skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
-    goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(110.0), resting_state=0)
+    goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(110.0), resting_state=0, yaw_symmetric=False)  # labelled
     T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
     plan = Planner(cube, (), predictor=SpinsBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, goal)
     assert plan.route[0] == plan.route[-1] == 0 and len(plan.route) == 3
@@ -314,6 +315,33 @@ def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn()
     aligned = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(5.0), resting_state=0)
     plan = Planner(cube, (), predictor=SpinsBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, aligned)
     assert plan.route == [0]
+
+
+def test_a_goal_yaw_is_met_modulo_the_objects_symmetry():
+    """A cube turned by 90 deg is the same solid in the same place: a goal 95 deg round needs a 5 deg turn (none),
+    unless the goal says markings tell the turns apart. An upright 32-facet planter needs no turn at all."""
+    cube = ap.load_object("cube")
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
+    planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    plan = planner.plan(T0, ap.Goal(xy=(0.6, 0.05), yaw=math.radians(95.0), resting_state=0))
+    assert "spin" not in [s.skill for s in plan.steps]
+    labelled = planner.plan(T0, ap.Goal(xy=(0.6, 0.05), yaw=math.radians(95.0), resting_state=0, yaw_symmetric=False))
+    spins = [s.params["angle"] for s in labelled.steps if s.skill == "spin"]
+    assert abs(math.degrees(sum(spins)) - 95.0) <= 10.0
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(T0, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=10)
+    assert ex.success and abs(math.degrees(wrap_angle(cube.planar_pose(ex.final_pose)[3]))) < 1.0, str(ex)
+
+    planter = ap.load_object("planter_1")
+    upright = next(i for i in range(len(planter.resting_states)) if planter.yaw_period(i) < math.radians(15))
+    T0 = planter.resting_states[upright].pose((0.45, 0.0), 0.0)
+    for yaw in (0.0, 1.0, 2.5, -2.0):
+        goal = ap.Goal(xy=(0.6, 0.0), yaw=yaw, resting_state=upright)
+        plan = Planner(planter, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0).plan(T0, goal)
+        assert plan.steps and {s.skill for s in plan.steps} == {"push"}
+        assert goal.reached(planter, plan.steps[-1].expected_pose)
 
 
 class PushesSquareOnly(StubPredictor):

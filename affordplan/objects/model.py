@@ -25,7 +25,7 @@ import trimesh
 
 from affordplan.errors import InputError, MeshError
 from affordplan.objects import decompose, family, repair
-from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states
+from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states, yaw_period
 from affordplan.objects.shapes import CATALOGUE, Shape
 
 DEFAULT_SIZE = 0.05  # largest half-extent, metres
@@ -57,6 +57,7 @@ class ObjectModel:
         self.inertia = np.asarray(inertia, dtype=float)
         self.hull = repair.bounded_hull(mesh)
         self._samples: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+        self._yaw_periods: dict[int, float] = {}
 
     def __repr__(self) -> str:
         return (f"ObjectModel({self.name!r}, extents={np.round(self.mesh.extents, 3).tolist()} m, "
@@ -79,6 +80,13 @@ class ObjectModel:
         state = self.classify(pose)
         yaw = self.resting_states[state].yaw_of(np.asarray(pose)[:3, :3])
         return state, float(pose[0, 3]), float(pose[1, 3]), float(yaw)
+
+    def yaw_period(self, state: int) -> float:
+        """Radians: turning a pose of resting ``state`` by this about the vertical gives the same solid in the
+        same place (``2 pi``: no symmetry); yaws in the state are equal modulo it (:func:`resting.yaw_period`)."""
+        if state not in self._yaw_periods:
+            self._yaw_periods[state] = yaw_period(self.mesh.vertices, self.resting_states[state].up)
+        return self._yaw_periods[state]
 
     def tilt_from_state(self, pose: np.ndarray, state: int) -> float:
         """Angle (radians) between a pose's up-vector and the nearest one of ``state``."""

@@ -21,11 +21,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import trimesh
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
 
 from affordplan.geometry import rot_z, yaw_of_direction
 
 DEFAULT_MERGE_ANGLE = math.radians(25.0)
 MIN_PROBABILITY = 0.01  # states rarer than this are dropped; classify maps them to the nearest kept
+MAX_SYMMETRY_ORDER = 64  # turns of 2 pi / n about the vertical tried for n = 2..64
+SYMMETRY_TOLERANCE = 2e-4  # metres: a turned vertex this close to a vertex coincides with it
 
 
 @dataclass(frozen=True)
@@ -160,6 +164,26 @@ def compute_resting_states(
         RestingState(index=i, **{**s, "probability": s["probability"] / total})
         for i, s in enumerate(states)
     ]
+
+
+def yaw_period(vertices: np.ndarray, up: np.ndarray, max_order: int = MAX_SYMMETRY_ORDER,
+               tol: float = SYMMETRY_TOLERANCE) -> float:
+    """The smallest turn about ``up`` (object-frame unit vector through the origin) that maps ``vertices`` onto
+    themselves: ``2 pi / n`` for the largest ``n <= max_order`` that does, ``2 pi`` when none (radians).
+
+    A resting state whose pose turned by this angle is the same solid in the same place: an upright 32-facet
+    cylinder has a period of 11.25 deg, a cube on a face 90 deg, a lying box 180 deg. The test is on the mesh's
+    vertices (a turned vertex must land within ``tol`` metres of a vertex), so a scanned mesh, whose vertices
+    never land on each other, has no symmetry: the check errs towards asking for the yaw.
+    """
+    vertices = np.asarray(vertices, dtype=float)
+    up = np.asarray(up, dtype=float) / np.linalg.norm(up)
+    tree = cKDTree(vertices)
+    for n in range(max_order, 1, -1):
+        turned = Rotation.from_rotvec(up * (2.0 * math.pi / n)).apply(vertices)
+        if tree.query(turned, distance_upper_bound=tol)[0].max() <= tol:
+            return 2.0 * math.pi / n
+    return 2.0 * math.pi
 
 
 def classify(states: list[RestingState], R_world_object: np.ndarray) -> int:
