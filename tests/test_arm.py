@@ -28,6 +28,32 @@ def test_arm_push_moves_the_cube_like_the_finger(cube):
     assert by_arm.tracking_error_median <= by_arm.tracking_error_max
 
 
+class ForceProbe(ap.Simulator):
+    """Records the contact force the arm feels after each control chunk (N)."""
+
+    def _step(self, n, guarded=True):
+        super()._step(n, guarded)
+        self.forces = getattr(self, "forces", []) + [float(np.linalg.norm(self._pusher.contact_force()))]
+
+
+@pytest.mark.parametrize("limited", [True, False])
+def test_pressing_down_on_a_cube_is_force_limited(cube, monkeypatch, limited):
+    """A full downward motion (9 cm into the cube's top): the arm, limited to the training finger's 30 N, feels
+    ~55 N on average (the limit acts a chunk late); without the limit its stiff joints press with ~200 N."""
+    if not limited:
+        monkeypatch.setattr(ap.sim.pushers.ArmPusher, "max_force", 1e9)
+    sim = ForceProbe(cube, pusher="arm")
+    T0 = sim.reset(resting_state=0, xy=(0.55, 0.0), yaw=0.0)
+    sim.forces = []
+    out = sim.execute(T0[:3, 3] + np.array([0.0, 0.0, 0.05]), (0.0, 0.0, -1.0), normal=(0.0, 0.0, 1.0))
+    assert out.approach_ok and out.valid, out.invalid_reason
+    assert np.linalg.norm(out.pose_after[:3, 3] - T0[:3, 3]) < 0.005  # pressed, not moved
+    pressing = [f for f in sim.forces if f > 1.0]
+    assert len(pressing) > 50  # 1.5 s of motion steps
+    mean = float(np.mean(pressing))
+    assert (mean < 80.0) if limited else (mean > 150.0), mean
+
+
 def test_no_arm_link_touches_a_wall_between_home_and_object(cube):
     """The wall stands between the arm's home pose and the cube; the arm transits over it."""
     wall = ap.Box(center=(0.45, 0.0), size=(0.03, 0.5, 0.16))

@@ -78,11 +78,22 @@ class FingerPusher:
 
 
 class ArmPusher:
-    """The 7-DOF arm of :mod:`affordplan.sim.arm`, its fingertip driven by mink IK at 50 Hz."""
+    """The 7-DOF arm of :mod:`affordplan.sim.arm`, its fingertip driven by mink IK at 50 Hz.
+
+    **Force limit.** The arm's joints are stiff (their torque caps allow ~170 N at the fingertip), and the
+    IK target runs on whether or not the arm is blocked, so a motion into an object pressed it into the table
+    (the ``"sank"`` guard) where the training finger, capped at 30 N an axis, would have stopped. Each
+    control chunk, the net contact force the arm feels beyond ``max_force`` (N) moves the commanded target
+    back along that force by the excess over ``admittance_stiffness`` (N/m); below the limit the offset
+    relaxes towards zero by ``offset_relax`` of itself a chunk. Free motion (no contact) is unchanged.
+    """
 
     name = "arm"
     radius = arm.TIP_RADIUS
     transit_speed = 0.5  # m/s, fingertip speed between primitives
+    max_force = 30.0  # N: the training finger's cap
+    admittance_stiffness = 20000.0  # N/m
+    offset_relax = 0.2
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, ik: arm.ArmIK, chunk_time: float,
                  safe_height: Callable[[], float]):
@@ -97,9 +108,11 @@ class ArmPusher:
         self._ctrl = np.array(acts)
         self._site = model.site(arm.FINGERTIP_SITE).id
         self._target = np.zeros(3)
+        self._offset = np.zeros(3)  # metres added to the commanded target by the force limit
         bodies = {model.body(n).id for n in arm.ARM_BODIES}
         self.geoms = np.array([g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in bodies])
         self._own_geoms = frozenset(int(g) for g in self.geoms)
+        self._wrench = np.zeros(6)
 
     @property
     def q(self) -> np.ndarray:
@@ -114,6 +127,7 @@ class ArmPusher:
         self.ik.set_q(np.array(arm.HOME))
         mujoco.mj_forward(self.model, d)
         self._target = self.tip()
+        self._offset = np.zeros(3)
 
     def go_to(self, pos: np.ndarray, servo: Servo) -> None:
         """Transit: up to the safe height, across, and down to ``pos``."""
@@ -149,8 +163,29 @@ class ArmPusher:
 
     def command(self, target: np.ndarray) -> None:
         self._target = np.asarray(target, dtype=float).copy()
-        q_next = self.ik.step(self._target)
+        force = self.contact_force()
+        excess = float(np.linalg.norm(force)) - self.max_force
+        if excess > 0.0:
+            self._offset += force / np.linalg.norm(force) * (excess / self.admittance_stiffness)
+        else:
+            self._offset *= 1.0 - self.offset_relax
+        q_next = self.ik.step(self._target + self._offset)
         self.data.ctrl[self._ctrl] = (q_next - self.data.act[self._act]) / self._chunk_time
+
+    def contact_force(self) -> np.ndarray:
+        """Net force (world frame, N) that everything the arm touches exerts on it, now."""
+        d = self.data
+        total = np.zeros(3)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            g1, g2 = int(c.geom1), int(c.geom2)
+            mine1, mine2 = g1 in self._own_geoms, g2 in self._own_geoms
+            if mine1 == mine2:
+                continue
+            mujoco.mj_contactForce(self.model, d, i, self._wrench)
+            f_world = c.frame.reshape(3, 3).T @ self._wrench[:3]  # on geom2, from geom1 (normal: 1 -> 2)
+            total += f_world if mine2 else -f_world
+        return total
 
     def target(self) -> np.ndarray:
         return self._target.copy()
