@@ -38,8 +38,9 @@ class ForceProbe(ap.Simulator):
 
 @pytest.mark.parametrize("limited", [True, False])
 def test_pressing_down_on_a_cube_is_force_limited(cube, monkeypatch, limited):
-    """A full downward motion (9 cm into the cube's top): the arm, limited to the training finger's 30 N, feels
-    ~55 N on average (the limit acts a chunk late); without the limit its stiff joints press with ~200 N."""
+    """A full downward motion (9 cm into the cube's top): the arm, limited to 15 N (about the training finger's
+    cap), feels ~45 N on average (the limit acts a chunk late); without the limit its stiff joints press with
+    ~200 N."""
     if not limited:
         monkeypatch.setattr(ap.sim.pushers.ArmPusher, "max_force", 1e9)
     sim = ForceProbe(cube, pusher="arm")

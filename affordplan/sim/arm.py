@@ -13,9 +13,10 @@ ConfigurationLimit, VelocityLimit and CollisionAvoidanceLimit (arm links vs tabl
 The joint targets are interpolated every physics step without Python: each joint's position actuator
 has an integrator activation (the target), and its control is the target's velocity over the chunk,
 so the target moves linearly from one IK solution to the next (kp 20000, kv 200, torques capped at
-the Panda's 87 / 12 N m). Those caps allow ~170 N at the fingertip, far above the training finger's 30 N,
-so :class:`affordplan.sim.pushers.ArmPusher` limits the contact force itself: the target gives way along
-the force the arm feels beyond 30 N (an admittance), which keeps rolls from pressing objects into the table.
+the Panda's 87 / 12 N m). Those caps allow ~170 N at the fingertip, far above the training finger's 10 N
+an axis, so :class:`affordplan.sim.pushers.ArmPusher` limits the contact force itself: the target gives way
+along the force the arm feels beyond 15 N (an admittance), which keeps rolls from pressing objects into the
+table.
 """
 
 from __future__ import annotations

@@ -29,8 +29,8 @@ Servo = Callable[[np.ndarray, np.ndarray, float], None]
 class FingerPusher:
     """A capsule fingertip on three world-axis slide joints; its tip sphere centre is the body origin.
 
-    Each axis is a position actuator (kp 2000 N/m, kv 40 N s/m) capped at 30 N, like a robot's
-    fingertip; an unbounded push (a mocap weld) squeezes objects out against the table at speeds no
+    Each axis is a position actuator (kp 2000 N/m, kv 40 N s/m) capped at 10 N (``scene.FINGER_MAX_FORCE``),
+    like a robot's fingertip; an unbounded push (a mocap weld) squeezes objects out against the table at speeds no
     robot produces, and a learned policy finds that exploit.
     """
 
@@ -82,7 +82,7 @@ class ArmPusher:
 
     **Force limit.** The arm's joints are stiff (their torque caps allow ~170 N at the fingertip), and the
     IK target runs on whether or not the arm is blocked, so a motion into an object pressed it into the table
-    (the ``"sank"`` guard) where the training finger, capped at 30 N an axis, would have stopped. Each
+    (the ``"sank"`` guard) where the training finger, capped at 10 N an axis, would have stopped. Each
     control chunk, the net contact force the arm feels beyond ``max_force`` (N) moves the commanded target
     back along that force by the excess over ``admittance_stiffness`` (N/m); below the limit the offset
     relaxes towards zero by ``offset_relax`` of itself a chunk. Free motion (no contact) is unchanged.
@@ -91,7 +91,7 @@ class ArmPusher:
     name = "arm"
     radius = arm.TIP_RADIUS
     transit_speed = 0.5  # m/s, fingertip speed between primitives
-    max_force = 30.0  # N: the training finger's cap
+    max_force = 15.0  # N: about the training finger's (10 N an axis)
     admittance_stiffness = 20000.0  # N/m
     offset_relax = 0.2
 
