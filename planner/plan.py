@@ -12,9 +12,6 @@
    the fingertip needs beside the object).
 4. **Calls.** Paths become pushes and spins (:mod:`planner.chain`); each step carries its expected
    pose and its predicted success (:class:`planner.predict.Predictor`); ``Plan.p_success`` is their product.
-5. **Carrying.** Where the goal is far and another resting state pushes clearly better than the goal's,
-   routes through it are planned too: roll into it, push the object to the goal there, roll into the goal's
-   state beside the goal (:meth:`Planner._candidates`). The plan with the highest ``p_success`` is kept.
 
 Failures reported back (:meth:`Planner.record_failure`) down-weight what failed: a roll edge in the
 graph, or a push direction (relative to the object) / spin sense in a resting state, which the next
@@ -62,13 +59,6 @@ SPIN_DETOUR_BELOW = 0.3
 # turn at the same spot spent whole executions.
 ROLL_SPOT_FAILURES = 2
 ROLL_SPOT_RADIUS = 0.04
-# Carrying (Planner._candidates): where the goal is this far (metres), routes through resting states whose pushes
-# are rated CARRY_MARGIN above the goal state's (mean over CARRY_PROBE_DIRECTIONS directions) are planned too,
-# the best CARRY_CANDIDATES of them, and the likeliest plan wins.
-CARRY_MIN_DISTANCE = 0.1
-CARRY_MARGIN = 0.2
-CARRY_CANDIDATES = 2
-CARRY_PROBE_DIRECTIONS = 8
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 
@@ -149,7 +139,6 @@ class Planner:
         self.failures: Counter = Counter()
         self.failed_roll_spots: list[tuple[float, float]] = []  # (x, y) of every failed roll, metres
         self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
-        self._push_p: dict[int, float] = {}  # resting state -> predicted push success (_push_rating)
         self.footprints = inflated_footprints(obj, clearance)
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
@@ -197,78 +186,24 @@ class Planner:
 
     # --------------------------------------------------------------------- plan
     def plan(self, T_start: np.ndarray, goal: Goal) -> Plan:
-        """A plan from the settled pose ``T_start`` to ``goal``; raises PlanningError / GoalError.
-
-        Of the candidate routes (:meth:`_candidates`: the graph's, and ones that carry the object in a resting
-        state where it pushes better), the plan whose steps are likeliest to all succeed.
-        """
+        """A plan from the settled pose ``T_start`` to ``goal``; raises PlanningError / GoalError."""
         t0 = time.perf_counter()
         deadline = t0 + self.time_limit
         state, x, y, yaw = self.obj.planar_pose(T_start)
         goal_state = self.check_goal(goal, state)
         turn = not goal.yaw_free(self.obj, goal_state)  # whether the goal's yaw asks for anything
-        best: tuple[float, list[Step], list[int], list] | None = None
-        error: PlanningError | None = None
-        for route, carry in self._candidates(state, goal_state, (x, y, yaw), goal, turn):
-            try:
-                steps, paths = self._chain(route, carry, (x, y, yaw), goal, turn, deadline)
-            except PlanningError as exc:
-                error = error or exc
-                continue
-            p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
-            if best is None or p > best[0]:
-                best = (p, steps, route, paths)
-        self._calls += 1
-        if best is None:
-            raise error
-        p, steps, route, paths = best
-        return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
-                    goal=goal, start_pose=np.array(T_start), planner=self)
-
-    def _candidates(self, state: int, goal_state: int, start, goal: Goal,
-                    turn: bool) -> list[tuple[list[int], int | None]]:
-        """Routes worth a plan, each with the index of the roll before which the object is carried (or ``None``).
-
-        First the graph's likeliest chain of rolls (with a detour to turn, :meth:`_route_to_turn`): the object
-        rolls where it is and is pushed to the goal in the goal's resting state. Where the goal is more than
-        :data:`CARRY_MIN_DISTANCE` away, also up to :data:`CARRY_CANDIDATES` routes through a resting state
-        ``t`` whose pushes the success model rates :data:`CARRY_MARGIN` above the goal state's: roll into
-        ``t``, push the object to the goal there, and roll into the goal's state beside it (a lying ellipsoid
-        that pushes send rolling is stood up, carried and laid down again).
-        """
         route = self.graph.route(state, goal_state)
         if turn:
-            route = self._route_to_turn(route, start[2], goal)
-        out: list[tuple[list[int], int | None]] = [(route, None)]
-        if math.hypot(goal.xy[0] - start[0], goal.xy[1] - start[1]) < CARRY_MIN_DISTANCE:
-            return out
-        floor = self._push_rating(goal_state) + CARRY_MARGIN
-        carriers = sorted((t for t in range(len(self.obj.resting_states))
-                           if t != goal_state and self._push_rating(t) >= floor), key=lambda t: -self._push_rating(t))
-        for t in carriers[:CARRY_CANDIDATES]:
-            try:
-                there = self.graph.route(state, t)
-                back = self.graph.route(t, goal_state)
-            except PlanningError:
-                continue
-            out.append((there + back[1:], len(there) - 1))
-        return out
-
-    def _chain(self, route: list[int], carry: int | None, start, goal: Goal, turn: bool,
-               deadline: float) -> tuple[list[Step], list[tuple[int, np.ndarray]]]:
-        """The steps (and the SE(2) path of each resting state) along ``route``; the roll at index ``carry`` is
-        made beside the goal instead of where the object is."""
-        state, goal_state = route[0], route[-1]
+            route = self._route_to_turn(route, yaw, goal)
         calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
         paths: list[tuple[int, np.ndarray]] = []
-        cur = tuple(start)
+        cur = (x, y, yaw)
         if not self.checkers[state].is_free(*cur):  # pushed into a tight spot: push it out first
             free = self._nearest_free(state, cur)
-            calls.append((state, "push", {"direction": math.atan2(free[1] - cur[1], free[0] - cur[0])},
-                          (*free, cur[2])))
-            cur = (*free, cur[2])
+            calls.append((state, "push", {"direction": math.atan2(free[1] - y, free[0] - x)}, (*free, yaw)))
+            cur = (*free, yaw)
         for k, (a, b) in enumerate(zip(route, route[1:])):
-            spot = self._roll_spot(a, b, cur, goal, beside_goal=k == carry)
+            spot = self._roll_spot(a, b, cur, goal)
             want_yaw = cur[2]
             last_roll = k == len(route) - 2
             if turn and last_roll and self._turns_better(a, goal_state):
@@ -290,7 +225,11 @@ class Planner:
         paths.append((goal_state, path))
         calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if turn else None,
                                                                  is_free=self.checkers[goal_state].is_free)]
-        return self._steps(state, tuple(start), calls), paths
+        steps = self._steps(state, (x, y, yaw), calls)
+        p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
+        self._calls += 1
+        return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
+                    goal=goal, start_pose=np.array(T_start), planner=self)
 
     def _steps(self, state: int, start: tuple[float, float, float], calls) -> list[Step]:
         steps: list[Step] = []
@@ -324,17 +263,6 @@ class Planner:
             turns = [{"angle": a} for a in (TURN_PROBE_ANGLE, -TURN_PROBE_ANGLE)]
             self._spin_p[state] = float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
         return self._spin_p[state]
-
-    def _push_rating(self, state: int) -> float:
-        """Predicted success of a push in ``state``, the mean over :data:`CARRY_PROBE_DIRECTIONS` directions
-        relative to the object at the workspace centre; asked once per state, like :meth:`_spin_probability`."""
-        if state not in self._push_p:
-            x, y = self.workspace.center
-            T = state_pose(self.obj, state, x, y, 0.0)
-            pushes = [("push", {"direction": float(a)}, T)
-                      for a in np.linspace(-math.pi, math.pi, CARRY_PROBE_DIRECTIONS, endpoint=False)]
-            self._push_p[state] = float(np.mean(self.predictor.p_success_many(pushes)))
-        return self._push_p[state]
 
     def _spin_rating(self, state: int) -> float:
         """:meth:`_spin_probability`, or 0 where a spin in ``state`` (either way) has failed twice."""
@@ -436,7 +364,7 @@ class Planner:
                     return float(px), float(py)
         raise PlanningError(f"the object is stuck at {tuple(np.round(cur[:2], 3))}: no free position nearby")
 
-    def _roll_spot(self, a: int, b: int, cur, goal: Goal, beside_goal: bool = False) -> tuple[float, float]:
+    def _roll_spot(self, a: int, b: int, cur, goal: Goal) -> tuple[float, float]:
         """Nearest place where a roll from state ``a`` to ``b`` has room.
 
         The room is a disc around the object, clear of obstacles. A disc inside the workspace is preferred
@@ -449,7 +377,7 @@ class Planner:
         ws = self.workspace
         grown = Workspace(x=(ws.x[0] - r, ws.x[1] + r), y=(ws.y[0] - r, ws.y[1] + r))
         for room in (FootprintChecker(disc, self.obstacles, ws), FootprintChecker(disc, self.obstacles, grown)):
-            spot = self._nearest_room(room, a, cur, goal, beside_goal)
+            spot = self._nearest_room(room, a, cur, goal)
             if spot is not None:
                 return spot
         raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
@@ -459,20 +387,14 @@ class Planner:
         near = sum(math.hypot(x - fx, y - fy) <= ROLL_SPOT_RADIUS for fx, fy in self.failed_roll_spots)
         return near >= ROLL_SPOT_FAILURES
 
-    def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal,
-                      beside_goal: bool = False) -> tuple[float, float] | None:
-        """Where to roll: the object's own place when it has room, else the free spot (1 cm grid) nearest the
-        object and then the goal; with ``beside_goal``, the free spot nearest the goal."""
-        if not beside_goal and room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) \
-                and not self._spoiled(*cur[:2]):
+    def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal) -> tuple[float, float] | None:
+        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self._spoiled(*cur[:2]):
             return float(cur[0]), float(cur[1])
-        w_cur, w_goal = (0.0, 1.0) if beside_goal else (1.0, 0.5)
         ws = self.workspace
         best, best_cost = None, math.inf
         for px in np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01):
             for py in np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01):
-                cost = w_cur * math.hypot(px - cur[0], py - cur[1]) + w_goal * math.hypot(px - goal.xy[0],
-                                                                                           py - goal.xy[1])
+                cost = math.hypot(px - cur[0], py - cur[1]) + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1])
                 if cost < best_cost and room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]) \
                         and not self._spoiled(px, py):
                     best, best_cost = (float(px), float(py)), cost

@@ -344,47 +344,6 @@ def test_a_goal_yaw_is_met_modulo_the_objects_symmetry():
         assert goal.reached(planter, plan.steps[-1].expected_pose)
 
 
-class PushesBadlyIn(StubPredictor):
-    """Rates pushes in one resting state at 0.05, every other call at 0.8."""
-
-    def __init__(self, skills, obj, state):
-        super().__init__(skills)
-        self.obj, self.state = obj, state
-
-    def p_success_many(self, queries):
-        return np.array([0.05 if skill == "push" and self.obj.classify(T) == self.state else self.p
-                         for skill, _, T in queries])
-
-
-def test_an_object_that_pushes_badly_is_carried_in_a_state_that_pushes_well():
-    """Start and goal share a resting state whose pushes the success model rates 0.05: roll into a state that
-    pushes well, push there, roll back beside the goal. A short way, or pushes rated alike, keeps the state."""
-    cube = ap.load_object("cube")
-    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
-    T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
-    goal = ap.Goal(xy=(0.66, 0.05), resting_state=0)
-    plan = Planner(cube, (), predictor=PushesBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, goal)
-    assert plan.route[0] == plan.route[-1] == 0 and len(plan.route) == 3
-    carrier = plan.route[1]
-    carried = {0: 0.0, carrier: 0.0}  # metres pushed in each state
-    for s in plan.steps:
-        if s.skill == "push":
-            carried[cube.classify(s.start_pose)] += math.dist(s.start_pose[:2, 3], s.expected_pose[:2, 3])
-    assert carried[carrier] >= 3 * carried[0]  # the disc a roll needs does not fit at the workspace's edge
-    last_roll = [s for s in plan.steps if s.skill == "roll"][-1]
-    assert math.dist(last_roll.start_pose[:2, 3], goal.xy) < 0.06  # rolled back beside the goal
-    sim = ap.Simulator(cube, seed=0)
-    sim.set_object_pose(T0, settle=False)
-    ex = execute_plan(plan, sim=sim, max_primitives=30)
-    assert ex.success, str(ex)
-
-    plan = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0).plan(T0, goal)
-    assert plan.route == [0]
-    near = ap.Goal(xy=(0.48, 0.0), resting_state=0)
-    plan = Planner(cube, (), predictor=PushesBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, near)
-    assert plan.route == [0]
-
-
 class PushesSquareOnly(StubPredictor):
     """Rates pushes 0.9 where the object's yaw is a multiple of 90 deg (within 5 deg), 0.1 elsewhere."""
 
