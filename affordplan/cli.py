@@ -23,6 +23,7 @@ examples:
   affordplan bench sim                     # primitives per second and overhead over raw physics
   affordplan bench sim --pusher arm        # the 7-DOF arm through mink IK
   affordplan bench sim2sim -n 100          # the same primitives by finger and arm: outcome gap
+  affordplan bench sim2sim --skill roll    # the shipped skills' success, finger vs arm, same starts
   affordplan bench plan --tasks 50 --sim arm   # plan-and-execute success, affordplan vs greedy
 
 Run `affordplan COMMAND --help` for a command's options.
@@ -111,6 +112,12 @@ def _cmd_bench_sim(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
+    if args.skill:
+        from primitives.sim2sim import skill_sim2sim
+
+        for skill in args.skill:
+            print(skill_sim2sim(skill, args.n, seed=args.seed, progress=True).report())
+        return 0
     from affordplan.bench import bench_sim2sim
 
     for name in args.object:
@@ -308,13 +315,18 @@ def build_parser() -> argparse.ArgumentParser:
     s2s = bench_sub.add_parser(
         "sim2sim", help="finger vs arm on the same random primitives",
         description=_wrap("Run the same random primitives with the finger and with the arm and print how far "
-                          "the object's final poses differ (mean and 90th percentile)."),
-        epilog="example:\n  affordplan bench sim2sim --object cube mug -n 100",
+                          "the object's final poses differ (mean and 90th percentile); with --skill, run the "
+                          "shipped skills from the same starts with the same parameters in both and print their "
+                          "successes."),
+        epilog="examples:\n  affordplan bench sim2sim --object cube mug -n 100\n"
+               "  affordplan bench sim2sim --skill roll push -n 80 --seed 2",
         formatter_class=_formatter,
     )
     s2s.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     s2s.add_argument("-n", type=int, default=100, help="primitives per object (default: %(default)s)")
     s2s.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    s2s.add_argument("--skill", nargs="+", choices=["push", "roll", "spin"],
+                     help="compare the shipped skills' success instead (on held-out objects; -n draws each)")
     s2s.set_defaults(func=_cmd_bench_sim2sim)
 
     bp = bench_sub.add_parser(
