@@ -2,8 +2,8 @@
 
 Model: the Panda's joint frames, offsets and limits (as in its datasheet; the same frames as the
 MuJoCo Menagerie model), with capsule links instead of meshes, a hand with two closed, lengthened
-fingers (a pushing tool) and a fingertip capsule (radius 8 mm, the finger sim's) whose tip sphere
-centre is the ``fingertip`` site.
+fingers (a pushing tool) and a fingertip capsule (radius 8 mm with an 8 cm shaft, the finger sim's) whose
+tip sphere centre is the ``fingertip`` site.
 The base stands on the table at the world origin.
 
 Control: every 20 ms (50 Hz) mink solves one differential-IK step on an arm-only model (the arm,
@@ -46,6 +46,10 @@ TIP_RADIUS = 0.008
 # up to 12 cm tall while the fingertip pushes low on them.
 FINGER_LENGTH = 0.132
 HAND_TO_TIP = 0.058 + FINGER_LENGTH - TIP_RADIUS  # hand frame to the tip sphere centre, metres
+# The tip is a capsule with this much round shaft above its sphere, as long as the training finger's capsule
+# (scene.FINGER_LENGTH): with a 2 cm shaft the fingers' box met objects above it, and pushes and rolls that
+# work with the finger failed with the arm (turned the object more, or lost it).
+TIP_SHAFT = 0.08
 
 ARM_BODIES = ("link1", "link2", "link3", "link4", "link5", "link6", "link7", "hand")
 # Geoms kept clear of the table by the IK (the fingertip and fingers must reach it: they push).
@@ -97,9 +101,9 @@ def arm_body_xml() -> str:
                 <body name="hand" pos="0 0 0.107" quat="0.9238795 0 0 -0.3826834" gravcomp="1">
                   <inertial pos="0 0 0.04" mass="0.73" diaginertia="0.001 0.0025 0.0017"/>
                   <geom name="hand_c" type="box" size="0.025 0.09 0.03" pos="0 0 0.03" {_ARM_GEOM}/>
-                  <geom name="fingers_c" type="box" size="0.007 0.012 {(FINGER_LENGTH - 0.02) / 2}"
-                        pos="0 0 {0.058 + (FINGER_LENGTH - 0.02) / 2}" {_ARM_GEOM}/>
-                  <geom name="fingertip_c" type="capsule" fromto="0 0 {HAND_TO_TIP - 0.02} 0 0 {HAND_TO_TIP}"
+                  <geom name="fingers_c" type="box" size="0.007 0.012 {(FINGER_LENGTH - TIP_SHAFT) / 2}"
+                        pos="0 0 {0.058 + (FINGER_LENGTH - TIP_SHAFT) / 2}" {_ARM_GEOM}/>
+                  <geom name="fingertip_c" type="capsule" fromto="0 0 {HAND_TO_TIP - TIP_SHAFT} 0 0 {HAND_TO_TIP}"
                         size="{TIP_RADIUS}" contype="2" conaffinity="1" group="1" rgba="0.2 0.2 0.25 1"
                         friction="0.5 0.005 0.002"/>
                   <site name="{FINGERTIP_SITE}" pos="0 0 {HAND_TO_TIP}" size="0.004"/>
