@@ -39,6 +39,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import resource
 import sys
 import time
@@ -104,16 +105,40 @@ def exploration(cfg: TrainConfig) -> Exploration:
     return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted)
 
 
+def _finite(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
 def check_config(cfg: TrainConfig) -> None:
-    """Raise :class:`InputError` for a backend / workers / address combination that cannot run."""
+    """Raise :class:`InputError` for settings that cannot run: a count or budget out of range, a probability
+    outside [0, 1], NaN, missing ``--init`` weights, or a backend / workers / address combination."""
+    if cfg.primitive not in PRIMITIVES:
+        raise InputError(f"unknown primitive {cfg.primitive!r}; expected one of {PRIMITIVES}")
+    counts = dict(steps=(cfg.steps, 1), workers=(cfg.workers, 0), batch_size=(cfg.batch_size, 1),
+                  replay_size=(cfg.replay_size, cfg.batch_size), learning_starts=(cfg.learning_starts, 0),
+                  n_points=(cfg.n_points, 16), torch_threads=(cfg.torch_threads, 1),
+                  weight_sync_updates=(cfg.weight_sync_updates, 1), log_every_steps=(cfg.log_every_steps, 1))
+    for name, (value, least) in counts.items():
+        if not isinstance(value, int) or isinstance(value, bool) or value < least:
+            raise InputError(f"--{name.replace('_', '-')} must be a whole number >= {least}, got {value!r}")
+    for name in ("max_minutes", "checkpoint_minutes", "lr", "temperature"):
+        value = getattr(cfg, name)
+        if not _finite(value) or value <= 0:
+            raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {value!r}")
+    for name in ("p_params", "p_scripted", "epsilon"):
+        value = getattr(cfg, name)
+        if not _finite(value) or not 0.0 <= value <= 1.0:
+            raise InputError(f"--{name.replace('_', '-')} is a probability in [0, 1], got {value!r}")
+    if not _finite(cfg.motion_noise) or cfg.motion_noise < 0:
+        raise InputError(f"motion noise must be a number >= 0, got {cfg.motion_noise!r}")
+    if cfg.init is not None and not Path(cfg.init).is_file():
+        raise InputError(f"--init: no weights file at {cfg.init}")
     if cfg.backend not in BACKENDS:
         raise InputError(f"unknown backend {cfg.backend!r}; expected one of {BACKENDS}")
     if cfg.backend == "ray" and cfg.workers < 1:
         raise InputError("the ray backend runs one Ray actor per worker: give --workers 1 or more")
     if cfg.ray_address is not None and cfg.backend != "ray":
         raise InputError("--ray-address needs --backend ray")
-    if not 0.0 <= cfg.p_scripted <= 1.0:
-        raise InputError(f"--p-scripted is a probability, got {cfg.p_scripted}")
     if cfg.p_scripted > 0.0 and cfg.primitive != "push":
         raise InputError(f"--p-scripted exists for push only (primitives.scripted), not {cfg.primitive}")
 
@@ -165,6 +190,8 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
     gen = torch.Generator().manual_seed(cfg.seed)
     state = dict(global_step=0, n_updates=0, invalid=0, elapsed=0.0, rss_samples=[])
     ckpt_path = out / "checkpoint.pt"
+    if resume and not ckpt_path.exists():
+        print(f"no checkpoint in {out} to resume from: starting a new run there", file=sys.stderr)
     if resume and ckpt_path.exists():
         saved = ckpt.load(ckpt_path)
         model.load_state_dict(saved["model"])

@@ -183,3 +183,53 @@ def test_shipped_weights_load_offline_and_act(name):
     assert np.all(np.isfinite(contact)) and np.all(np.abs(motion) <= 1.0)
     again = load_skill(name).act(ap.Simulator(ap.load_object("cube"), seed=3))
     assert np.array_equal(again[0], contact) and np.array_equal(again[1], motion)  # deterministic
+
+
+@pytest.mark.parametrize("field, value, words", [
+    ("steps", 0, "--steps must be a whole number >= 1"),
+    ("steps", 10.5, "--steps must be a whole number"),
+    ("workers", -1, "--workers must be a whole number >= 0"),
+    ("batch_size", 0, "--batch-size must be a whole number >= 1"),
+    ("replay_size", 8, "--replay-size must be a whole number >= 32"),
+    ("n_points", 4, "--n-points must be a whole number >= 16"),
+    ("max_minutes", float("nan"), "--max-minutes must be a positive number"),
+    ("max_minutes", -5.0, "--max-minutes must be a positive number"),
+    ("lr", 0.0, "--lr must be a positive number"),
+    ("checkpoint_minutes", float("inf"), "--checkpoint-minutes must be a positive number"),
+    ("p_params", 1.2, "--p-params is a probability in [0, 1]"),
+    ("p_params", float("nan"), "--p-params is a probability in [0, 1]"),
+    ("primitive", "jump", "unknown primitive 'jump'"),
+    ("init", "no/such/weights.pt", "--init: no weights file at no/such/weights.pt"),
+])
+def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field, value, words):
+    from dataclasses import replace
+
+    from affordplan.errors import InputError
+    from primitives.train import TrainConfig, check_config, train
+
+    cfg = replace(TrainConfig(out=str(tmp_path / "run")), **{field: value})
+    with pytest.raises(InputError) as info:
+        check_config(cfg)
+    assert words in str(info.value)
+    with pytest.raises(InputError):
+        train(cfg, progress=False)
+    assert not (tmp_path / "run").exists()  # nothing written: refused before the run folder is made
+
+
+def test_the_cli_reports_bad_settings_as_usage_errors(capsys):
+    from primitives.train import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["push", "--p-params", "2", "--out", "/nonexistent/run"])
+    assert info.value.code == 2
+    assert "--p-params is a probability in [0, 1], got 2.0" in capsys.readouterr().err
+
+
+def test_resume_without_a_checkpoint_says_it_starts_a_new_run(tmp_path, capsys):
+    from primitives.train import TrainConfig, train
+
+    cfg = TrainConfig(primitive="push", steps=2, workers=0, out=str(tmp_path), objects=("cube",), n_points=64,
+                      replay_size=64, checkpoint_minutes=60.0)
+    summary = train(cfg, resume=True, progress=False)
+    assert summary["steps"] == 2 and (tmp_path / "checkpoint.pt").exists()
+    assert f"no checkpoint in {tmp_path} to resume from: starting a new run there" in capsys.readouterr().err
