@@ -290,6 +290,13 @@ def _free_along(checker: FootprintChecker, path: np.ndarray, resolution: float) 
     return all(checker.is_free(*pose) for pose in interpolate_path(path, resolution, math.radians(2.0)))
 
 
+def _turned_once(xy: np.ndarray, held: float, start, goal) -> np.ndarray:
+    """``xy`` positions at yaw ``held``, with the one turn in place: at the start when ``held`` is the goal's yaw
+    (``goal[2]`` unwrapped next to ``start[2]``), else at the goal."""
+    moving = np.column_stack([xy, np.full(len(xy), held)])
+    return np.vstack([start, moving]) if held == goal[2] else np.vstack([moving, goal])
+
+
 def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray, resolution: float = 0.005,
                      turn_first: bool = True) -> np.ndarray | None:
     """``waypoints``' positions at one held yaw with a single turn in place, when that stays free; else ``None``.
@@ -303,10 +310,8 @@ def single_turn_path(checker: FootprintChecker, waypoints: np.ndarray, resolutio
     waypoints = np.asarray(waypoints, dtype=float)
     (x0, y0, a0), (x1, y1, a1) = waypoints[0], waypoints[-1]
     a1 = a0 + wrap_angle(a1 - a0)
-    xy = waypoints[:, :2]
     for held in ((a1, a0) if turn_first else (a0, a1)):
-        path = np.column_stack([xy, np.full(len(xy), held)])
-        path = np.vstack([[x0, y0, a0], path]) if held == a1 else np.vstack([path, [x1, y1, a1]])
+        path = _turned_once(waypoints[:, :2], held, (x0, y0, a0), (x1, y1, a1))
         if _free_along(checker, path, resolution):
             return interpolate_path(path)
     return None
@@ -384,8 +389,7 @@ def _turn_once(checker: FootprintChecker, start, goal, *, time_limit: float, see
                               resolution=resolution)
         if xy is None:
             continue
-        moving = np.column_stack([xy, np.full(len(xy), held)])
-        path = np.vstack([[x0, y0, a0], moving]) if held == a1 else np.vstack([moving, [x1, y1, a1]])
+        path = _turned_once(xy, held, (x0, y0, a0), (x1, y1, a1))
         if _free_along(checker, path, resolution):
             return interpolate_path(path)
     return None

@@ -40,7 +40,7 @@ import torch.nn.functional as F
 from torch import nn
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError
+from affordplan.errors import AffordplanError, InputError
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.networks import HybridActorCritic
 
@@ -91,7 +91,7 @@ class SuccessNet(nn.Module):
     def __init__(self, in_dim: int = OBS_DIM, width: int = 64, members: int = 1):
         super().__init__()
         if members < 1:
-            raise ValueError(f"an ensemble needs at least one member, got {members}")
+            raise InputError(f"an ensemble needs at least one member, got {members}")
         self.members = nn.ModuleList(_Member(in_dim, width) for _ in range(members))
         # Platt scaling, fitted after training: p = sigmoid(a * logit + b).
         self.register_buffer("platt", torch.tensor([1.0, 0.0]))

@@ -192,7 +192,7 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
     ckpt_path = out / "checkpoint.pt"
     if resume and not ckpt_path.exists():
         print(f"no checkpoint in {out} to resume from: starting a new run there", file=sys.stderr)
-    if resume and ckpt_path.exists():
+    elif resume:
         saved = ckpt.load(ckpt_path)
         model.load_state_dict(saved["model"])
         opt_critic.load_state_dict(saved["opt_critic"])

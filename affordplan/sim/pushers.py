@@ -176,15 +176,14 @@ class ArmPusher:
         """Net force (world frame, N) that everything the arm touches exerts on it, now."""
         d = self.data
         total = np.zeros(3)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            g1, g2 = int(c.geom1), int(c.geom2)
-            mine1, mine2 = g1 in self._own_geoms, g2 in self._own_geoms
-            if mine1 == mine2:
-                continue
-            mujoco.mj_contactForce(self.model, d, i, self._wrench)
-            f_world = c.frame.reshape(3, 3).T @ self._wrench[:3]  # on geom2, from geom1 (normal: 1 -> 2)
-            total += f_world if mine2 else -f_world
+        if d.ncon == 0:
+            return total
+        c = d.contact
+        mine1, mine2 = np.isin(c.geom[:, 0], self.geoms), np.isin(c.geom[:, 1], self.geoms)
+        for i in np.flatnonzero(mine1 != mine2):  # the arm against something else
+            mujoco.mj_contactForce(self.model, d, int(i), self._wrench)
+            f_world = c.frame[i].reshape(3, 3).T @ self._wrench[:3]  # on geom2, from geom1 (normal: 1 -> 2)
+            total += f_world if mine2[i] else -f_world
         return total
 
     def target(self) -> np.ndarray:
