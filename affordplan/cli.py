@@ -306,7 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=_formatter,
     )
     sim.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
-    sim.add_argument("-n", type=int, default=500, help="primitives per object (default: %(default)s)")
+    sim.add_argument("-n", type=_positive_int, default=500, help="primitives per object (default: %(default)s)")
     sim.add_argument("--pusher", default="finger", choices=["finger", "arm"], help="pusher (default: finger)")
     sim.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     sim.add_argument("--json", action="store_true", help="print JSON instead of a report")
@@ -323,7 +323,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=_formatter,
     )
     s2s.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
-    s2s.add_argument("-n", type=int, default=100, help="primitives per object (default: %(default)s)")
+    s2s.add_argument("-n", type=_positive_int, default=100, help="primitives per object (default: %(default)s)")
     s2s.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     s2s.add_argument("--skill", nargs="+", choices=["push", "roll", "spin"],
                      help="compare the shipped skills' success instead (on held-out objects; -n draws each)")
@@ -338,7 +338,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json",
         formatter_class=_formatter,
     )
-    bp.add_argument("--tasks", type=int, default=50, help="number of tasks (default: %(default)s)")
+    bp.add_argument("--tasks", type=_positive_int, default=50, help="number of tasks (default: %(default)s)")
     bp.add_argument("--sim", default="arm", choices=["arm", "finger"], help="pusher (default: arm)")
     bp.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     bp.add_argument("--planner", nargs="+", default=["affordplan", "greedy"], choices=["affordplan", "greedy"],

@@ -153,6 +153,14 @@ def test_bench_registers_robustness_when_it_exists(monkeypatch, capsys):
 
 
 # ---------------------------------------------------------------------------------- errors
+@pytest.mark.parametrize("argv", [["bench", "sim", "-n", "0"], ["bench", "sim2sim", "--skill", "roll", "-n", "0"],
+                                  ["bench", "plan", "--tasks", "-3"]])
+def test_benchmark_counts_must_be_positive(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    assert info.value.code == 2 and "expected a positive integer" in capsys.readouterr().err
+
+
 def test_cli_reports_library_errors_cleanly(capsys, tmp_path):
     assert cli.main(["render", "teapot"]) == 2
     assert "unknown object 'teapot'" in capsys.readouterr().err
