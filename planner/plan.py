@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,6 +49,7 @@ DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  #
 # model rates a 30 deg spin there this much higher than in the goal's resting state (a frustum on its
 # side, say, cannot be spun; on its base it can).
 TURN_PROBE_ANGLE = math.radians(30.0)
+SPIN_RATE_GRID = np.radians(np.arange(15.0, 45.1, 2.5))  # spin angles rated per state to split turns (_spin_rate)
 TURN_BEFORE_MARGIN = 0.15
 # Where the goal's resting state spins this badly (predicted, or spins there failed twice) and no roll into
 # it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
@@ -139,6 +140,7 @@ class Planner:
         self.failures: Counter = Counter()
         self.failed_roll_spots: list[tuple[float, float]] = []  # (x, y) of every failed roll, metres
         self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
+        self._spin_rates: dict[int, np.ndarray] = {}  # resting state -> P(spin) over SPIN_RATE_GRID (_spin_rate)
         self.footprints = inflated_footprints(obj, clearance)
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
@@ -211,7 +213,7 @@ class Planner:
             spot_yaw = self._free_yaw(a, spot, want_yaw)
             path = self._path(a, cur, (*spot, spot_yaw), deadline)
             paths.append((a, path))
-            segment = chain.path_to_calls(path, is_free=self.checkers[a].is_free)
+            segment = chain.path_to_calls(path, is_free=self.checkers[a].is_free, spin_rate=self._spin_rate(a))
             calls += [(a, *c) for c in segment]
             if segment:
                 cur = segment[-1][2]
@@ -224,7 +226,8 @@ class Planner:
         path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
         paths.append((goal_state, path))
         calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if turn else None,
-                                                                 is_free=self.checkers[goal_state].is_free)]
+                                                                 is_free=self.checkers[goal_state].is_free,
+                                                                 spin_rate=self._spin_rate(goal_state))]
         steps = self._steps(state, (x, y, yaw), calls)
         p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
         self._calls += 1
@@ -263,6 +266,21 @@ class Planner:
             turns = [{"angle": a} for a in (TURN_PROBE_ANGLE, -TURN_PROBE_ANGLE)]
             self._spin_p[state] = float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
         return self._spin_p[state]
+
+    def _spin_rate(self, state: int) -> Callable[[float], float]:
+        """``rate(angle)``: predicted success of a spin by ``angle`` (radians, signed, 15-45 deg) in ``state``.
+
+        Read off :data:`SPIN_RATE_GRID` by linear interpolation; the grid is asked once per state at the workspace
+        centre, at yaw 0, as :meth:`_spin_probability` is (with the shipped spin's frame search, the rating hardly
+        depends on the yaw: it is the best over twelve turns of the frame).
+        """
+        if state not in self._spin_rates:
+            x, y = self.workspace.center
+            T = state_pose(self.obj, state, x, y, 0.0)
+            queries = [("spin", {"angle": float(sign * a)}, T) for sign in (1.0, -1.0) for a in SPIN_RATE_GRID]
+            self._spin_rates[state] = self.predictor.p_success_many(queries).reshape(2, len(SPIN_RATE_GRID))
+        table = self._spin_rates[state]
+        return lambda angle: float(np.interp(abs(angle), SPIN_RATE_GRID, table[0 if angle > 0 else 1]))
 
     def _spin_rating(self, state: int) -> float:
         """:meth:`_spin_probability`, or 0 where a spin in ``state`` (either way) has failed twice."""

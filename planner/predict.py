@@ -75,10 +75,11 @@ class Predictor:
         """Batched :meth:`p_success` (one network pass per skill)."""
         out = np.zeros(len(queries))
         for skill in SKILLS:
-            idx = [i for i, q in enumerate(queries) if q[0] == skill]
-            if idx:
-                obs = np.stack([self.observation(*queries[i]) for i in idx])
-                out[idx] = self.skills[skill].success_probability_obs(obs)
+            for parameterised in (True, False):
+                idx = [i for i, q in enumerate(queries) if q[0] == skill and (q[1] is not None) == parameterised]
+                if idx:
+                    obs = np.stack([self.observation(*queries[i]) for i in idx])
+                    out[idx] = self.skills[skill].success_probability_obs(obs, parameterised)
         self.queries += len(queries)
         return out
 

@@ -5,11 +5,11 @@ trained skills (``load_skill``)."""
 from primitives import rewards
 
 
-def load_skill(name: str, weights=None, success_weights=None):
-    """The ``push``, ``roll`` or ``spin`` skill (see :mod:`primitives.skills`)."""
+def load_skill(name: str, weights=None, success_weights=None, frame_search=True):
+    """The ``push``, ``roll`` or ``spin`` skill (see :func:`primitives.skills.load_skill`)."""
     from primitives.skills import load_skill as _load
 
-    return _load(name, weights, success_weights)
+    return _load(name, weights, success_weights, frame_search)
 
 
 __all__ = ["load_skill", "rewards"]

@@ -26,6 +26,7 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
 from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
+from primitives.frames import FrameSearch, select_frame
 from primitives.networks import HybridActorCritic, widen_input
 
 # The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
@@ -77,6 +78,9 @@ class EvalResult:
     per_object: dict[str, list[bool]] = field(default_factory=dict)
     invalid: int = 0
     params: str = "none"
+    frames: str = "goal frame"  # or "best of M free frames" (frame search)
+    predicted: list[float] = field(default_factory=list)  # the success model's rating of each trial (frame search)
+    outcomes: list[bool] = field(default_factory=list)  # every trial's success, in order
 
     @property
     def success_rate(self) -> float:
@@ -86,10 +90,21 @@ class EvalResult:
     def rates(self) -> dict[str, float]:
         return {k: float(np.mean(v)) for k, v in self.per_object.items()}
 
+    def calibration(self) -> dict | None:
+        """ECE, Brier, AUROC and mean rating of the success model's ratings (frame search only)."""
+        if not self.predicted:
+            return None
+        from primitives.success import metrics
+
+        return metrics(np.array(self.predicted), np.array(self.outcomes, dtype=bool))
+
     def as_dict(self) -> dict:
-        return dict(primitive=self.primitive, objects=self.objects, success=self.success_rate,
-                    trials=sum(len(v) for v in self.per_object.values()), invalid=self.invalid, params=self.params,
-                    per_object=self.rates())
+        out = dict(primitive=self.primitive, objects=self.objects, success=self.success_rate,
+                   trials=sum(len(v) for v in self.per_object.values()), invalid=self.invalid, params=self.params,
+                   per_object=self.rates())
+        if self.predicted:
+            out.update(frames=self.frames, calibration=self.calibration())
+        return out
 
 
 def held_out_config(primitive: str, p_params: float) -> EnvConfig:
@@ -98,12 +113,21 @@ def held_out_config(primitive: str, p_params: float) -> EnvConfig:
 
 
 def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str, ...] = "random",
-             trials: int = 200, seed: int = 1234, progress: bool = True, p_params: float = 0.0) -> EvalResult:
+             trials: int = 200, seed: int = 1234, progress: bool = True, p_params: float = 0.0,
+             frame_search: FrameSearch | None = None,
+             success_weights: str | os.PathLike | None = None) -> EvalResult:
     """Success over ``trials`` stable starts (per object for ``seed7`` and paths).
 
     ``p_params``: the share of trials that ask for a random parameter (0: the seed's objective; 1:
     every trial parameterised, judged by the parameterised criterion).
+    ``frame_search``: act in the free goal frame the success model (``success_weights``, the shipped one by
+    default) rates likeliest (:mod:`primitives.frames`), and record its calibrated ratings.
     """
+    predict = None
+    if frame_search is not None:
+        from primitives.success import SuccessModel, load_success_net
+
+        predict = SuccessModel(model, load_success_net(primitive, success_weights)).predict
     if objects == "random":
         cfg = held_out_config(primitive, p_params)
         plan = [None] * trials
@@ -116,11 +140,20 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
                         params={0.0: "none", 1.0: "random"}.get(p_params, f"p={p_params:.2f}"))
     for key in tqdm(plan, desc=f"evaluate {primitive}", disable=not progress, unit="trial", mininterval=2.0):
         obs = env.reset(object_key=key)
+        if predict is not None:
+            frames = frame_search.frames(primitive, env.seen.params)
+            env.seen, rating = select_frame(env.seen, predict, frames)
+            obs = env.seen.obs
+            if len(frames) > 1:
+                result.frames = f"best of {len(frames)} free frames"
+                rating = float(frame_search.calibrate(rating, env.seen.params is not None))
+            result.predicted.append(rating)
         idx, motion, _ = greedy_action(model, obs)
         res = env.step(idx, motion)
         result.invalid += not res.valid
         name = "random" if key is None else str(key)
         result.per_object.setdefault(name, []).append(res.success)
+        result.outcomes.append(bool(res.success))
     env.close()
     return result
 
@@ -207,10 +240,37 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=1234)
     p.add_argument("--params", choices=["none", "random"], default="none",
                    help="none: the seed's objective; random: every trial asks for a random parameter")
+    p.add_argument("--frames", default=None, metavar="shipped|PATH",
+                   help="frame search (primitives.frames): act in the free goal frame the success model rates "
+                        "likeliest, as the shipped skill does (shipped) or as a frames.json says; default: the goal "
+                        "frame, as trained")
+    p.add_argument("--frame-turns", type=int, default=None, metavar="N",
+                   help="an uncalibrated frame search over N turns, where the request leaves the turn free")
+    p.add_argument("--frame-mirror", action="store_true",
+                   help="with --frame-turns: also the mirrored frames, where the request leaves the mirror free")
+    p.add_argument("--success-weights", default=None, help="success model for the frame search (default: shipped)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--plot", default=None, help="write bar charts (the seed's Fig. 3 / Fig. 5) here")
     p.add_argument("--critic-map", default=None, help="write the critic map figure (the seed's Fig. 2) here")
     return p
+
+
+def _frame_search(args: argparse.Namespace, parser: argparse.ArgumentParser) -> FrameSearch | None:
+    """The frame search the flags ask for (``--frames`` or ``--frame-turns`` / ``--frame-mirror``), or None."""
+    if args.frames is not None and (args.frame_turns is not None or args.frame_mirror):
+        parser.error("give --frames or --frame-turns / --frame-mirror, not both")
+    if args.frames == "shipped":
+        from primitives.skills import shipped_frame_search
+
+        search = shipped_frame_search(args.primitive)
+        if search is None:
+            parser.error(f"no frame search is shipped for {args.primitive}")
+        return search
+    if args.frames is not None:
+        return FrameSearch.load(args.frames)
+    if args.frame_turns is not None or args.frame_mirror:
+        return FrameSearch(1 if args.frame_turns is None else args.frame_turns, args.frame_mirror)
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -222,8 +282,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         model = load_policy(args.weights, args.primitive)
         objects = args.objects[0] if args.objects[0] in ("random", "seed7") else tuple(args.objects)
+        search = _frame_search(args, parser)
         result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
-                          p_params=1.0 if args.params == "random" else 0.0)
+                          p_params=1.0 if args.params == "random" else 0.0, frame_search=search,
+                          success_weights=args.success_weights)
     except AffordplanError as exc:  # missing or broken weights, an unreadable mesh, ...
         print(f"primitives.evaluate: error: {exc}", file=sys.stderr)
         return 2
@@ -232,6 +294,10 @@ def main(argv: list[str] | None = None) -> int:
     else:
         print(f"{args.primitive}: success {result.success_rate:.3f} over "
               f"{sum(len(v) for v in result.per_object.values())} trials ({result.invalid} invalid)")
+        cal = result.calibration()
+        if cal is not None:
+            print(f"  {result.frames}; success model on the chosen frames: mean rating {cal['mean_prediction']:.3f}, "
+                  f"ECE {cal['ece']:.3f}, Brier {cal['brier']:.3f}, AUROC {cal['auroc']:.3f}")
         for name, rate in result.rates().items():
             seed = SEED_FIG5.get(name)
             ref = f"   seed {seed[PRIMITIVES.index(args.primitive)]:.3f}" if seed else ""

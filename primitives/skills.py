@@ -10,6 +10,12 @@ Parameters (:mod:`primitives.params`): push ``{"direction": rad}`` (world headin
 ``{"angle": rad}`` (signed, 15-45 deg), roll ``{"target": state index}`` (one roll away); ``None`` is
 the seed's objective. ``Outcome.success`` applies the matching criterion (:func:`primitives.rewards.success`).
 The policy acts greedily, so ``act`` and ``execute`` are deterministic for a given cloud.
+
+**Frame search** (:mod:`primitives.frames`): with a :class:`~primitives.frames.FrameSearch`, the skill looks at
+the cloud in the goal frames its request leaves free and acts in the one its success model rates likeliest;
+``success_probability`` is that rating, calibrated for the choice. The shipped skills use the search shipped
+beside their weights (``weights/{name}_frames.json``) where there is one; without, they act in the goal frame, as
+trained.
 """
 
 from __future__ import annotations
@@ -24,8 +30,9 @@ from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.env import PRIMITIVES, SkillObservation, skill_observation
 from primitives.evaluate import greedy_action, load_policy
+from primitives.frames import FrameSearch, reframe_obs, select_frame
 from primitives.networks import HybridActorCritic
-from primitives.success import SuccessModel, load_success_net
+from primitives.success import WEIGHTS_DIR, SuccessModel, load_success_net
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -35,16 +42,33 @@ class Skill:
     """A trained primitive acting greedily on a simulator's point cloud, with its success model."""
 
     def __init__(self, name: str, model: HybridActorCritic, n_points: int = 256,
-                 success_weights: str | os.PathLike | None = None):
+                 success_weights: str | os.PathLike | None = None, frame_search: FrameSearch | None = None):
         self.name = name
         self.model = model
         self.n_points = n_points
         self._success_weights = success_weights
         self._success: SuccessModel | None = None
+        self.frame_search = frame_search
+
+    def frames(self, params) -> np.ndarray:
+        """The goal frames this skill tries for (checked) ``params``: ``(m, 3, 3)``, the identity first."""
+        return (FrameSearch() if self.frame_search is None else self.frame_search).frames(self.name, params)
+
+    def _observe_rated(self, sim: Simulator, params=None) -> tuple[SkillObservation, float | None]:
+        """:meth:`observe` and, where frames were searched, the calibrated rating of the chosen one."""
+        seen = skill_observation(sim, self.name, params, self.n_points)
+        frames = self.frames(seen.params)
+        if len(frames) == 1:
+            return seen, None
+        seen, p = select_frame(seen, self.success_model.predict, frames)
+        return seen, float(self.frame_search.calibrate(p, seen.params is not None))
 
     def observe(self, sim: Simulator, params=None) -> SkillObservation:
-        """Cloud, the policy's observation, the checked params and the goal frame (raises InputError)."""
-        return skill_observation(sim, self.name, params, self.n_points)
+        """Cloud, the policy's observation, the checked params and the goal frame (raises InputError).
+
+        With a frame search, the goal frame is the free frame the success model rates likeliest.
+        """
+        return self._observe_rated(sim, params)[0]
 
     def _decide(self, seen: SkillObservation,
                 allowed: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -90,17 +114,42 @@ class Skill:
 
     def success_probability(self, sim: Simulator, params=None) -> float:
         """Predicted probability that ``execute(sim, params)`` succeeds now (no physics is run)."""
-        return float(self.success_model.predict(self.observe(sim, params).obs))
+        seen, p = self._observe_rated(sim, params)
+        return float(self.success_model.predict(seen.obs)) if p is None else p
 
-    def success_probability_obs(self, obs: np.ndarray) -> np.ndarray:
-        """Predicted P(success) for observations built with :func:`primitives.env.skill_observation`."""
-        return self.success_model.predict(obs)
+    def success_probability_obs(self, obs: np.ndarray, parameterised: bool = True) -> np.ndarray:
+        """Predicted P(success) for observations ``(N, 9)`` or ``(B, N, 9)`` built in the goal frame
+        (:func:`primitives.env.observe_cloud`), all with a parameter or all without; with a frame search, the
+        calibrated rating of the best free frame."""
+        frames = self.frames({} if parameterised else None)
+        if len(frames) == 1:
+            return self.success_model.predict(obs)
+        obs = np.asarray(obs, dtype=np.float32)
+        p = self.success_model.predict(reframe_obs(obs, frames).reshape(-1, *obs.shape[-2:]))
+        return self.frame_search.calibrate(p.reshape(*obs.shape[:-2], len(frames)).max(axis=-1), parameterised)
+
+
+def shipped_frame_search(name: str) -> FrameSearch | None:
+    """The frame search shipped beside a skill's weights (``weights/{name}_frames.json``), if any."""
+    path = WEIGHTS_DIR / f"{name}_frames.json"
+    return FrameSearch.load(path) if path.exists() else None
 
 
 def load_skill(name: str, weights: str | os.PathLike | None = None,
-               success_weights: str | os.PathLike | None = None) -> Skill:
-    """The ``push``, ``roll`` or ``spin`` skill, from the shipped weights or given files."""
+               success_weights: str | os.PathLike | None = None,
+               frame_search: FrameSearch | bool = True) -> Skill:
+    """The ``push``, ``roll`` or ``spin`` skill, from the shipped weights or given files.
+
+    ``frame_search`` (:mod:`primitives.frames`): ``True``, the one shipped beside the weights where there is one;
+    ``False``, act in the goal frame, as trained; or a :class:`~primitives.frames.FrameSearch`.
+    """
     if name not in PRIMITIVES:
         raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
-    return Skill(name, load_policy(weights, name), success_weights=success_weights)
+    if frame_search is True:
+        frame_search = shipped_frame_search(name)
+    elif frame_search is False:
+        frame_search = None
+    elif not isinstance(frame_search, FrameSearch):
+        raise InputError(f"frame_search must be True, False or a FrameSearch, got {frame_search!r}")
+    return Skill(name, load_policy(weights, name), success_weights=success_weights, frame_search=frame_search)

@@ -190,6 +190,44 @@ def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train",
                     np.array(par_l))
 
 
+@torch.no_grad()
+def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split: str = "train",
+                         n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
+                         progress: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` valid greedy rollouts acting in the frame of ``search`` (:class:`primitives.frames.FrameSearch`)
+    that ``model`` rates likeliest: ``(best raw rating, success, parameterised)``, each ``(n,)``."""
+    from primitives.evaluate import greedy_action
+    from primitives.frames import select_frame
+
+    env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
+                                 episodes_per_object=4), seed=seed)
+    rating, succ, par = [], [], []
+    bar = tqdm(total=n, desc=f"frame-search rollouts {skill} ({split})", disable=not progress, unit="rollout",
+               mininterval=2.0)
+    while len(succ) < n:
+        env.reset()
+        env.seen, p = select_frame(env.seen, model.predict, search.frames(skill, env.seen.params))
+        idx, motion, _ = greedy_action(model.policy, env.seen.obs)
+        res = env.step(idx, motion)
+        if not res.valid:
+            continue
+        rating.append(p)
+        succ.append(res.success)
+        par.append(res.params is not None)
+        bar.update(1)
+    bar.close()
+    env.close()
+    return np.array(rating), np.array(succ), np.array(par)
+
+
+def fit_frame_calibration(rating: np.ndarray, success: np.ndarray) -> tuple[float, float]:
+    """``(a, b)`` of the Platt scaling ``sigmoid(a logit(p) + b)`` of the chosen frames' ratings ``p``."""
+    p = np.clip(np.asarray(rating, dtype=float), 1e-6, 1.0 - 1e-6)
+    z = torch.from_numpy(np.log(p / (1.0 - p)).astype(np.float32))
+    a, b = _platt(z, torch.from_numpy(np.asarray(success, dtype=np.float32))).tolist()
+    return float(a), float(b)
+
+
 # ------------------------------------------------------------------------------ metrics
 def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
     """Expected calibration error over ``bins`` equal-width bins."""
@@ -358,7 +396,20 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("--seed", type=int, default=0 if name == "train" else 4321)
         s.add_argument("--out", default=None, help="folder for rollouts, model, figures (default: runs/SKILL_success)")
         s.add_argument("--json", action="store_true")
+    f = sub.add_parser("frames", help="calibrate a frame search (primitives.frames) on training objects")
+    f.add_argument("skill", choices=PRIMITIVES)
+    f.add_argument("--policy", default=None, help="policy weights (default: the shipped ones)")
+    f.add_argument("--model", default=None, help="success model rating the frames (default: shipped)")
+    f.add_argument("--turns", type=int, default=12, help="turns about the vertical, where free (default: 12)")
+    f.add_argument("--mirror", action="store_true", help="also the mirrored frames, where free")
+    f.add_argument("--rollouts", type=int, default=2000)
+    f.add_argument("--seed", type=int, default=0)
+    f.add_argument("--out", default=None, help="folder for frames.json (default: runs/SKILL_frames)")
+    f.add_argument("--json", action="store_true")
     sub.choices["evaluate"].add_argument("--model", default=None, help="success model (default: shipped)")
+    sub.choices["evaluate"].add_argument("--frames", default=None, metavar="shipped|PATH",
+                                         help="judge the skill acting with this frame search (frames.json, or the "
+                                              "shipped one) and its calibrated ratings")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
     sub.choices["train"].add_argument("--epochs", type=int, default=40)
     sub.choices["train"].add_argument("--members", type=int, default=1,
@@ -384,6 +435,8 @@ def main(argv: list[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     from primitives.evaluate import load_policy
 
+    if args.command == "frames":
+        return _run_frames(args)
     out = Path(args.out or f"runs/{args.skill}_success")
     out.mkdir(parents=True, exist_ok=True)
     policy = load_policy(args.policy, args.skill)
@@ -398,8 +451,10 @@ def _run(args: argparse.Namespace) -> int:
         print(json.dumps(info, indent=2))
         return 0
     net = load_success_net(args.skill, args.model)
-    data = collect(policy, args.skill, args.rollouts, "test", n_objects=200, seed=args.seed, progress=not args.json)
     model = SuccessModel(policy, net)
+    if args.frames is not None:
+        return _evaluate_frames(args, model)
+    data = collect(policy, args.skill, args.rollouts, "test", n_objects=200, seed=args.seed, progress=not args.json)
     with torch.no_grad():
         p = net(torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)).numpy()
     result = dict(skill=args.skill, objects="test split (never trained on)", all=metrics(p, data.success),
@@ -407,6 +462,55 @@ def _run(args: argparse.Namespace) -> int:
                   query_ms=1e3 * bench_query(model, data.obs[0].astype(np.float32)))
     if args.plot:
         plot_reliability(p, data.success, args.plot, f"{args.skill} success model, unseen objects")
+    print(json.dumps(result, indent=2))
+    return 0
+
+
+def _run_frames(args: argparse.Namespace) -> int:
+    """``frames``: frame-searched rollouts on training objects, and the Platt scaling of the chosen ratings."""
+    from primitives.evaluate import load_policy
+    from primitives.frames import FrameSearch
+
+    out = Path(args.out or f"runs/{args.skill}_frames")
+    out.mkdir(parents=True, exist_ok=True)
+    search = FrameSearch(args.turns, args.mirror)
+    model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
+    t0 = time.perf_counter()
+    rating, success, par = collect_frame_search(model, args.skill, args.rollouts, search, "train", seed=args.seed,
+                                                progress=not args.json)
+    platt = fit_frame_calibration(rating[par], success[par])
+    platt_seed = fit_frame_calibration(rating[~par], success[~par]) if (~par).sum() >= 50 else (1.0, 0.0)
+    search = FrameSearch(search.turns, search.mirror, platt, platt_seed)
+    p = np.where(par, search.calibrate(rating, True), search.calibrate(rating, False))
+    info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped",
+                model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
+                frames_seed_objective=len(search.frames(args.skill, None)), minutes=(time.perf_counter() - t0) / 60,
+                success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
+                calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]),
+                command=f"python -m primitives.success frames {args.skill} --turns {args.turns}"
+                        f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts} --seed {args.seed}")
+    search = FrameSearch(search.turns, search.mirror, platt, platt_seed, info)
+    search.save(out / "frames.json")
+    print((out / "frames.json").read_text())
+    return 0
+
+
+def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
+    """``evaluate --frames``: the skill acting with a frame search on unseen objects, and its calibrated ratings."""
+    from primitives.frames import FrameSearch
+    from primitives.skills import shipped_frame_search
+
+    search = shipped_frame_search(args.skill) if args.frames == "shipped" else FrameSearch.load(args.frames)
+    if search is None:
+        raise InputError(f"no frame search is shipped for {args.skill}")
+    rating, success, par = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
+                                                seed=args.seed, progress=not args.json)
+    p = np.where(par, search.calibrate(rating, True), search.calibrate(rating, False))
+    result = dict(skill=args.skill, objects="test split (never trained on)", frames=args.frames,
+                  all=metrics(p, success), parameterised=metrics(p[par], success[par]),
+                  seed_objective=metrics(p[~par], success[~par]) if (~par).any() else None)
+    if args.plot:
+        plot_reliability(p, success, args.plot, f"{args.skill} success model, frame search, unseen objects")
     print(json.dumps(result, indent=2))
     return 0
 

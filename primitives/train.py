@@ -109,6 +109,17 @@ def _finite(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
+# Settings the command line sets; the others are TrainConfig fields only.
+_CLI_SETTINGS = frozenset({"steps", "workers", "max_minutes", "checkpoint_minutes", "lr", "p_params", "p_scripted",
+                           "batch_size", "replay_size", "learning_starts", "weight_sync_updates", "n_points",
+                           "torch_threads"})
+
+
+def _setting(name: str) -> str:
+    """How to name a setting in an error: its flag where the command line has one, else its field."""
+    return f"--{name.replace('_', '-')}" if name in _CLI_SETTINGS else f"TrainConfig.{name}"
+
+
 def check_config(cfg: TrainConfig) -> None:
     """Raise :class:`InputError` for settings that cannot run: a count or budget out of range, a probability
     outside [0, 1], NaN, missing ``--init`` weights, or a backend / workers / address combination."""
@@ -117,20 +128,21 @@ def check_config(cfg: TrainConfig) -> None:
     counts = dict(steps=(cfg.steps, 1), workers=(cfg.workers, 0), batch_size=(cfg.batch_size, 1),
                   replay_size=(cfg.replay_size, cfg.batch_size), learning_starts=(cfg.learning_starts, 0),
                   n_points=(cfg.n_points, 16), torch_threads=(cfg.torch_threads, 1),
-                  weight_sync_updates=(cfg.weight_sync_updates, 1), log_every_steps=(cfg.log_every_steps, 1))
+                  weight_sync_updates=(cfg.weight_sync_updates, 1), log_every_steps=(cfg.log_every_steps, 1),
+                  actor_delay=(cfg.actor_delay, 1), sim_cache=(cfg.sim_cache, 1), n_objects=(cfg.n_objects, 1))
     for name, (value, least) in counts.items():
         if not isinstance(value, int) or isinstance(value, bool) or value < least:
-            raise InputError(f"--{name.replace('_', '-')} must be a whole number >= {least}, got {value!r}")
-    for name in ("max_minutes", "checkpoint_minutes", "lr", "temperature"):
+            raise InputError(f"{_setting(name)} must be a whole number >= {least}, got {value!r}")
+    for name in ("max_minutes", "checkpoint_minutes", "lr", "temperature", "replay_ratio"):
         value = getattr(cfg, name)
         if not _finite(value) or value <= 0:
-            raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {value!r}")
+            raise InputError(f"{_setting(name)} must be a positive number, got {value!r}")
     for name in ("p_params", "p_scripted", "epsilon"):
         value = getattr(cfg, name)
         if not _finite(value) or not 0.0 <= value <= 1.0:
-            raise InputError(f"--{name.replace('_', '-')} is a probability in [0, 1], got {value!r}")
+            raise InputError(f"{_setting(name)} is a probability in [0, 1], got {value!r}")
     if not _finite(cfg.motion_noise) or cfg.motion_noise < 0:
-        raise InputError(f"motion noise must be a number >= 0, got {cfg.motion_noise!r}")
+        raise InputError(f"{_setting('motion_noise')} must be a number >= 0, got {cfg.motion_noise!r}")
     if cfg.init is not None and not Path(cfg.init).is_file():
         raise InputError(f"--init: no weights file at {cfg.init}")
     if cfg.backend not in BACKENDS:

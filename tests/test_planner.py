@@ -127,6 +127,25 @@ def test_chained_calls_track_the_path():
     assert math.hypot(x - 0.5, y - 0.1) < 0.01 and abs(yaw - math.radians(-30)) <= chain.YAW_DEADBAND
 
 
+def test_turns_are_split_into_the_spins_rated_likeliest():
+    deg = math.radians
+
+    def rate(angle):  # a policy that spins 35 deg well, 15-25 deg badly, and clockwise worse
+        return (0.9 if abs(abs(angle) - deg(35)) < deg(1) else 0.3) * (1.0 if angle > 0 else 0.5)
+
+    assert np.allclose(chain.spins_for(deg(70)), [deg(45), deg(25)])  # unrated: the largest first
+    assert np.allclose(chain.spins_for(deg(70), rate), [deg(35), deg(35)])  # 0.81 beats 0.3 for 45 + 25
+    assert np.allclose(chain.spins_for(deg(30), rate), [deg(35)])  # within the 5 deg slack
+    assert np.allclose(chain.spins_for(deg(-70), rate), [deg(-35), deg(-35)])
+    assert chain.spins_for(deg(8), rate) == []  # inside the dead band
+    flat = chain.spins_for(deg(60), lambda a: 0.5)  # no preference: the fewest spins
+    assert len(flat) == 2 and sum(flat) == pytest.approx(deg(60), abs=deg(5.01))
+    for turn in np.radians([12, 20, 44, 50, 100, 170, -130]):  # every split sums to the turn within the slack
+        spins = chain.spins_for(turn, rate)
+        assert all(deg(15) - 1e-9 <= abs(a) <= deg(45) + 1e-9 for a in spins)
+        assert abs(sum(spins) - turn) <= chain.SPIN_SLACK + 1e-9
+
+
 def test_a_short_last_stride_is_two_full_pushes_in_a_v():
     """Pushes move at least PUSH_STEP: 3.5 cm to go is two 5 cm pushes whose sum is the stride, on the free side."""
     path = np.array([[0.6, 0.0, 0.3], [0.635, 0.0, 0.3]])

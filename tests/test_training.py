@@ -200,6 +200,11 @@ def test_shipped_weights_load_offline_and_act(name):
     ("p_params", float("nan"), "--p-params is a probability in [0, 1]"),
     ("primitive", "jump", "unknown primitive 'jump'"),
     ("init", "no/such/weights.pt", "--init: no weights file at no/such/weights.pt"),
+    # settings without a flag are named as TrainConfig fields
+    ("epsilon", -0.1, "TrainConfig.epsilon is a probability in [0, 1]"),
+    ("replay_ratio", 0.0, "TrainConfig.replay_ratio must be a positive number"),
+    ("actor_delay", 0, "TrainConfig.actor_delay must be a whole number >= 1"),
+    ("sim_cache", 0, "TrainConfig.sim_cache must be a whole number >= 1"),
 ])
 def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field, value, words):
     from dataclasses import replace

@@ -1,0 +1,128 @@
+"""Acting in the likeliest of the goal frames a request leaves free (test-time frame selection).
+
+The goal frame (:func:`primitives.params.goal_frame`) fixes what a parameter asks for and nothing else. What it
+leaves free are symmetries of the table (friction is isotropic; the physics does not change when the scene turns
+about the vertical or is mirrored through a vertical plane):
+
+- spin with an angle: any turn about the vertical (the mirror is taken: it makes every spin counter-clockwise);
+- push with a direction, roll to a target: the mirror ``y -> -y`` (the turn is taken: it aims the request at +x);
+- the seed's objective (no parameter): any turn, and the mirror.
+
+The policy is a point-cloud network trained from samples, so it is not invariant under these frames. Its success
+on one start differs with the frame it sees the start in: the spin success model gives the same 35 deg spin of
+one held-out object 0.63 at yaw 0 and 0.02 at yaw 1 rad. Each frame shows the policy a start it could equally
+have met in training (the same object turned, or mirrored), so a skill may evaluate ``n`` of them with its
+success model in one batch and act in the likeliest. The policy and the success model stay as trained.
+
+A frame is a 3x3 map ``B`` applied on top of the goal frame: ``A_frame_world' = B A_frame_world``. Every feature
+block of an observation (position, normal, goal flow) is a vector in the frame, so re-framing is one matrix
+product per block (:func:`reframe`).
+
+**Calibration.** The success model was calibrated on starts in one frame; the best of ``m`` ratings is biased
+upwards (it picks the frames the model over-rates as well as those that are good). :class:`FrameSearch` therefore
+carries a Platt scaling of the chosen rating, ``sigmoid(a logit(p) + b)``, fitted on frame-searched rollouts of
+training objects (``python -m primitives.success frames``) and shipped beside the skill's weights as
+``weights/{skill}_frames.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from affordplan.errors import InputError
+from affordplan.geometry import rot_z
+from primitives.env import OBS_DIM, SkillObservation
+
+MIRROR_Y = np.diag([1.0, -1.0, 1.0])
+
+
+def free_frames(skill: str, params: dict | None, n_turns: int, mirror: bool) -> np.ndarray:
+    """The frames ``B`` (``(m, 3, 3)``, the identity first) the request of ``skill`` leaves free.
+
+    ``n_turns``: turns about the vertical to try where a turn is free, evenly spaced (1: none). ``mirror``: also
+    try the mirror of each, where it is free.
+    """
+    if not isinstance(n_turns, int) or isinstance(n_turns, bool) or n_turns < 1:
+        raise InputError(f"n_turns must be a whole number >= 1, got {n_turns!r}")
+    turn_free = params is None or skill == "spin"
+    mirror_free = mirror and (params is None or skill != "spin")
+    turns = [rot_z(2.0 * math.pi * k / n_turns) for k in range(n_turns if turn_free else 1)]
+    frames = turns + ([MIRROR_Y @ R for R in turns] if mirror_free else [])
+    return np.stack(frames)
+
+
+def reframe_obs(obs: np.ndarray, frames: np.ndarray) -> np.ndarray:
+    """Observations ``(..., N, 9)`` seen in each of ``frames`` (``(m, 3, 3)``): ``(..., m, N, 9)`` float32."""
+    obs = np.asarray(obs, dtype=np.float32)
+    blocks = obs.reshape(*obs.shape[:-1], OBS_DIM // 3, 3)  # (..., N, 3, 3): position, normal, flow
+    out = np.einsum("mij,...nbj->...mnbi", frames.astype(np.float32), blocks)
+    return out.reshape(*obs.shape[:-2], len(frames), obs.shape[-2], OBS_DIM).astype(np.float32)
+
+
+def reframe(seen: SkillObservation, B: np.ndarray) -> SkillObservation:
+    """``seen`` with its goal frame followed by ``B``: the same cloud and request, the policy's input re-expressed."""
+    obs = reframe_obs(seen.obs, np.asarray(B, dtype=float)[None])[0]
+    return replace(seen, obs=obs, A_frame_world=np.asarray(B, dtype=float) @ seen.A_frame_world)
+
+
+def select_frame(seen: SkillObservation, predict, frames: np.ndarray) -> tuple[SkillObservation, float]:
+    """``seen`` in the frame of ``frames`` that ``predict`` (observations ``(m, N, 9)`` -> P(success) ``(m,)``)
+    rates likeliest, and that rating."""
+    if len(frames) == 1:
+        return seen, float(predict(seen.obs[None])[0])
+    p = np.asarray(predict(reframe_obs(seen.obs, frames)))
+    best = int(np.argmax(p))
+    return reframe(seen, frames[best]), float(p[best])
+
+
+@dataclass(frozen=True)
+class FrameSearch:
+    """Which free frames a skill tries, and the calibration of the chosen frame's rating.
+
+    ``turns``: turns about the vertical where the turn is free (1: none); ``mirror``: the mirror too, where it is
+    free; ``platt``: ``(a, b)`` of ``sigmoid(a logit(p) + b)`` on the best rating ``p`` of a request with a
+    parameter, ``platt_unparameterised`` the same for the seed's objective (which leaves more frames free, so its
+    best rating is biased more); ``(1, 0)``: none. ``info``: how the calibration was made (command, figures).
+    """
+
+    turns: int = 1
+    mirror: bool = False
+    platt: tuple[float, float] = (1.0, 0.0)
+    platt_unparameterised: tuple[float, float] = (1.0, 0.0)
+    info: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self):
+        free_frames("spin", None, self.turns, self.mirror)  # checks turns
+        for ab in (self.platt, self.platt_unparameterised):
+            if len(ab) != 2 or not all(math.isfinite(v) for v in ab):
+                raise InputError(f"a FrameSearch Platt scaling must be two finite numbers, got {ab!r}")
+
+    def frames(self, skill: str, params: dict | None) -> np.ndarray:
+        return free_frames(skill, params, self.turns, bool(self.mirror))
+
+    def calibrate(self, p: np.ndarray | float, parameterised: bool = True) -> np.ndarray:
+        """The calibrated probability of the best ratings ``p`` of requests with (or without) a parameter."""
+        p = np.clip(np.asarray(p, dtype=float), 1e-6, 1.0 - 1e-6)
+        a, b = self.platt if parameterised else self.platt_unparameterised
+        return 1.0 / (1.0 + np.exp(-(a * np.log(p / (1.0 - p)) + b)))
+
+    def save(self, path: str | os.PathLike) -> None:
+        d = asdict(self)
+        d["platt"], d["platt_unparameterised"] = list(self.platt), list(self.platt_unparameterised)
+        Path(path).write_text(json.dumps(d, indent=2) + "\n")
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> FrameSearch:
+        """A frame search from a JSON file (raises :class:`InputError` for an unreadable one)."""
+        try:
+            d = json.loads(Path(path).read_text())
+            return cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
+                       tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}))
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc

@@ -1,0 +1,108 @@
+"""Frame search: the free goal frames of each request, re-framing observations, the skill acting in the best."""
+
+import math
+
+import numpy as np
+import pytest
+
+import affordplan as ap
+from affordplan.errors import InputError
+from primitives import params as skill_params
+from primitives.env import observation, skill_observation
+from primitives.frames import MIRROR_Y, FrameSearch, free_frames, reframe, reframe_obs, select_frame
+
+
+def test_each_request_leaves_its_own_frames_free():
+    # spin by an angle: any turn (the mirror fixes the sense); push / roll: the mirror; no parameter: both
+    assert len(free_frames("spin", {"angle": 0.5}, 12, True)) == 12
+    assert len(free_frames("push", {"direction": 0.5}, 12, True)) == 2
+    assert len(free_frames("roll", {"target": 1}, 12, False)) == 1
+    assert len(free_frames("push", None, 12, True)) == 24
+    assert len(free_frames("spin", None, 8, False)) == 8
+    frames = free_frames("push", None, 4, True)
+    assert np.allclose(frames[0], np.eye(3))
+    for B in frames:  # orthogonal, keep the vertical
+        assert np.allclose(B @ B.T, np.eye(3)) and np.allclose(B[2], [0, 0, 1])
+    assert np.allclose(frames[4], MIRROR_Y)
+    with pytest.raises(InputError):
+        free_frames("spin", None, 0, False)
+
+
+def test_reframing_an_observation_is_observing_in_the_new_frame():
+    sim = ap.Simulator(ap.load_object("mug"), seed=1)
+    sim.reset()
+    seen = skill_observation(sim, "spin", {"angle": -0.5}, 128)
+    B = free_frames("spin", None, 12, True)[15]  # a mirrored turn
+    again = reframe(seen, B)
+    flow = skill_params.goal_flow("spin", seen.params, seen.points, sim.object_pose(), sim.obj)
+    direct = observation(seen.points, seen.normals, flow, B @ seen.A_frame_world)
+    assert np.allclose(again.obs, direct, atol=1e-6)
+    assert np.allclose(again.motion_to_world(B @ seen.A_frame_world @ np.array([0.3, -0.2, 0.1])), [0.3, -0.2, 0.1])
+    batch = reframe_obs(np.stack([seen.obs, seen.obs]), free_frames("spin", None, 3, False))
+    assert batch.shape == (2, 3, 128, 9) and np.allclose(batch[1, 0], seen.obs)
+
+
+def test_select_frame_takes_the_best_rated_frame():
+    sim = ap.Simulator(ap.load_object("cube"), seed=0)
+    sim.reset()
+    seen = skill_observation(sim, "spin", {"angle": 0.4}, 64)
+    frames = free_frames("spin", None, 6, False)
+    wanted = 4
+
+    def predict(obs):  # rates the frame whose first point's x matches frame 4's
+        target = reframe(seen, frames[wanted]).obs[0, 0]
+        return np.exp(-np.abs(obs[:, 0, 0] - target) * 1e3)
+
+    chosen, p = select_frame(seen, predict, frames)
+    assert np.allclose(chosen.A_frame_world, frames[wanted] @ seen.A_frame_world) and p == pytest.approx(1.0)
+
+
+def test_frame_search_calibration_and_files(tmp_path):
+    search = FrameSearch(12, True, (0.8, -0.3), (0.5, -1.0), {"rollouts": 10})
+    p = np.array([0.1, 0.5, 0.9])
+    q = search.calibrate(p)
+    assert np.all(np.diff(q) > 0) and q[1] == pytest.approx(1 / (1 + math.exp(0.3)))
+    assert search.calibrate(0.5, parameterised=False) == pytest.approx(1 / (1 + math.exp(1.0)))
+    assert np.allclose(FrameSearch().calibrate(p), p)
+    search.save(tmp_path / "f.json")
+    back = FrameSearch.load(tmp_path / "f.json")
+    assert back == search and back.info == {"rollouts": 10}
+    (tmp_path / "bad.json").write_text("{\"turns\": 3}")
+    with pytest.raises(InputError, match="unreadable"):
+        FrameSearch.load(tmp_path / "bad.json")
+    with pytest.raises(InputError):
+        FrameSearch(12, True, (float("nan"), 0.0))
+    with pytest.raises(InputError):
+        FrameSearch(12, True, (1.0, 0.0), (1.0,))
+
+
+def test_a_skill_with_frame_search_acts_in_its_likeliest_frame():
+    from primitives import load_skill
+
+    plain = load_skill("spin", frame_search=False)
+    search = FrameSearch(8, False)  # no calibration: the rating is the success model's
+    skill = load_skill("spin", frame_search=search)
+    obj = ap.load_object("lunch_box")
+
+    def fresh():  # the same start and the same cloud for every query
+        sim = ap.Simulator(obj, seed=2)
+        sim.reset()
+        return sim
+
+    params = {"angle": math.radians(30)}
+    seen = skill_observation(fresh(), "spin", params, 256)
+    ratings = plain.success_model.predict(reframe_obs(seen.obs, search.frames("spin", params)))
+    assert skill.success_probability(fresh(), params) == pytest.approx(ratings.max(), abs=1e-6)
+    assert plain.success_probability(fresh(), params) == pytest.approx(ratings[0], abs=1e-6)
+    chosen = skill.observe(fresh(), params)
+    best = search.frames("spin", params)[int(np.argmax(ratings))]
+    assert np.allclose(chosen.A_frame_world, best @ seen.A_frame_world)
+    contact, motion = skill.act(fresh(), params)
+    from primitives.evaluate import greedy_action
+
+    idx, m, _ = greedy_action(skill.model, chosen.obs)
+    assert np.allclose(contact, chosen.points[idx]) and np.allclose(motion, chosen.motion_to_world(m))
+    # the batched query the planner makes agrees with the one on the simulator
+    assert skill.success_probability_obs(seen.obs[None])[0] == pytest.approx(ratings.max(), abs=1e-6)
+    with pytest.raises(InputError):
+        load_skill("spin", frame_search="yes")
