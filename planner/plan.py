@@ -49,7 +49,7 @@ DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  #
 # model rates a 30 deg spin there this much higher than in the goal's resting state (a frustum on its
 # side, say, cannot be spun; on its base it can).
 TURN_PROBE_ANGLE = math.radians(30.0)
-SPIN_RATE_GRID = np.radians(np.arange(15.0, 45.1, 2.5))  # spin angles rated per state to split turns (_spin_rate)
+SPIN_RATE_GRID = np.radians([15.0, 25.0, 35.0, 45.0])  # spin angles rated per state to split turns (_spin_rate)
 TURN_BEFORE_MARGIN = 0.15
 # Where the goal's resting state spins this badly (predicted, or spins there failed twice) and no roll into
 # it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
@@ -140,7 +140,7 @@ class Planner:
         self.failures: Counter = Counter()
         self.failed_roll_spots: list[tuple[float, float]] = []  # (x, y) of every failed roll, metres
         self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
-        self._spin_rates: dict[int, np.ndarray] = {}  # resting state -> P(spin) over SPIN_RATE_GRID (_spin_rate)
+        self._spin_rates: dict[tuple[int, int], np.ndarray] = {}  # (state, sense) -> P(spin) over SPIN_RATE_GRID
         self.footprints = inflated_footprints(obj, clearance)
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
@@ -248,10 +248,13 @@ class Planner:
             new_state = params["target"] if skill == "roll" else call_state
             T_next = state_pose(self.obj, new_state, *after)
             steps.append(Step(skill, params, T, T_next))
+            if skill == "spin":  # rated by the state's spin row, as its split was (_spin_rate)
+                steps[-1].p_success = self._spin_rate(call_state)(params["angle"])
             T = T_next
-        if steps:
-            ps = self.predictor.p_success_many([(s.skill, s.params, s.start_pose) for s in steps])
-            for s, p in zip(steps, ps):
+        asked = [s for s in steps if s.skill != "spin"]
+        if asked:
+            ps = self.predictor.p_success_many([(s.skill, s.params, s.start_pose) for s in asked])
+            for s, p in zip(asked, ps):
                 s.p_success = float(p)
         return steps
 
@@ -270,17 +273,21 @@ class Planner:
     def _spin_rate(self, state: int) -> Callable[[float], float]:
         """``rate(angle)``: predicted success of a spin by ``angle`` (radians, signed, 15-45 deg) in ``state``.
 
-        Read off :data:`SPIN_RATE_GRID` by linear interpolation; the grid is asked once per state at the workspace
-        centre, at yaw 0, as :meth:`_spin_probability` is (with the shipped spin's frame search, the rating hardly
-        depends on the yaw: it is the best over twelve turns of the frame).
+        Read off :data:`SPIN_RATE_GRID` by linear interpolation. Each sense's row is asked once per state, when
+        first needed, at the workspace centre and yaw 0, as :meth:`_spin_probability` is: with the shipped spin's
+        frame search the rating hardly depends on the yaw (it is the best over turns of the frame), and a row
+        costs ``len(SPIN_RATE_GRID)`` frame-searched queries.
         """
-        if state not in self._spin_rates:
-            x, y = self.workspace.center
-            T = state_pose(self.obj, state, x, y, 0.0)
-            queries = [("spin", {"angle": float(sign * a)}, T) for sign in (1.0, -1.0) for a in SPIN_RATE_GRID]
-            self._spin_rates[state] = self.predictor.p_success_many(queries).reshape(2, len(SPIN_RATE_GRID))
-        table = self._spin_rates[state]
-        return lambda angle: float(np.interp(abs(angle), SPIN_RATE_GRID, table[0 if angle > 0 else 1]))
+        def rate(angle: float) -> float:
+            key = (state, 1 if angle > 0 else -1)
+            if key not in self._spin_rates:
+                x, y = self.workspace.center
+                T = state_pose(self.obj, state, x, y, 0.0)
+                self._spin_rates[key] = self.predictor.p_success_many(
+                    [("spin", {"angle": float(key[1] * a)}, T) for a in SPIN_RATE_GRID])
+            return float(np.interp(abs(angle), SPIN_RATE_GRID, self._spin_rates[key]))
+
+        return rate
 
     def _spin_rating(self, state: int) -> float:
         """:meth:`_spin_probability`, or 0 where a spin in ``state`` (either way) has failed twice."""

@@ -106,3 +106,14 @@ def test_a_skill_with_frame_search_acts_in_its_likeliest_frame():
     assert skill.success_probability_obs(seen.obs[None])[0] == pytest.approx(ratings.max(), abs=1e-6)
     with pytest.raises(InputError):
         load_skill("spin", frame_search="yes")
+
+
+@pytest.mark.parametrize("name", ["push", "roll", "spin"])
+def test_the_shipped_skills_search_the_frames_shipped_beside_them(name):
+    from primitives import load_skill
+    from primitives.success import WEIGHTS_DIR
+
+    shipped = FrameSearch.load(WEIGHTS_DIR / f"{name}_frames.json")
+    assert load_skill(name).frame_search == shipped
+    assert shipped.info["command"].startswith(f"python -m primitives.success frames {name}")
+    assert load_skill(name, frame_search=False).frame_search is None
