@@ -64,8 +64,10 @@ class SkillObservation:
     A_frame_world: np.ndarray  # (3, 3) world vectors -> goal frame
 
     def motion_to_world(self, motion: np.ndarray) -> np.ndarray:
-        """A goal-frame motion in [-1, 1]^3 as a world-frame one."""
-        return self.A_frame_world.T @ np.asarray(motion, dtype=float)
+        """A goal-frame motion in [-1, 1]^3 as a world-frame one, clipped to [-1, 1]^3 per world axis as
+        :meth:`affordplan.Simulator.execute` clips it (a frame turned about the vertical can stretch an axis to
+        sqrt(2)): what the simulator will execute."""
+        return np.clip(self.A_frame_world.T @ np.asarray(motion, dtype=float), -1.0, 1.0)
 
 
 @dataclass
