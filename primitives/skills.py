@@ -140,14 +140,15 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
                frame_search: FrameSearch | bool = True) -> Skill:
     """The ``push``, ``roll`` or ``spin`` skill, from the shipped weights or given files.
 
-    ``frame_search`` (:mod:`primitives.frames`): ``True``, the one shipped beside the weights where there is one;
+    ``frame_search`` (:mod:`primitives.frames`): ``True``, the one shipped beside the weights where there is one
+    and both the policy and the success model are the shipped ones (its calibration is theirs), else none;
     ``False``, act in the goal frame, as trained; or a :class:`~primitives.frames.FrameSearch`.
     """
     if name not in PRIMITIVES:
         raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
     if frame_search is True:
-        frame_search = shipped_frame_search(name)
+        frame_search = shipped_frame_search(name) if weights is None and success_weights is None else None
     elif frame_search is False:
         frame_search = None
     elif not isinstance(frame_search, FrameSearch):

@@ -117,3 +117,15 @@ def test_the_shipped_skills_search_the_frames_shipped_beside_them(name):
     assert load_skill(name).frame_search == shipped
     assert shipped.info["command"].startswith(f"python -m primitives.success frames {name}")
     assert load_skill(name, frame_search=False).frame_search is None
+
+
+def test_given_weights_get_no_shipped_frame_search(tmp_path):
+    import torch
+
+    from primitives import load_skill
+    from primitives.networks import HybridActorCritic
+
+    torch.save(HybridActorCritic().state_dict(), tmp_path / "w.pt")
+    assert load_skill("spin", weights=tmp_path / "w.pt").frame_search is None  # the shipped calibration is not theirs
+    search = FrameSearch(4, False)
+    assert load_skill("spin", weights=tmp_path / "w.pt", frame_search=search).frame_search == search
