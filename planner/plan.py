@@ -413,6 +413,8 @@ class Planner:
         return near >= ROLL_SPOT_FAILURES
 
     def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal) -> tuple[float, float] | None:
+        """Where to roll: the object's own place when it has room, else the free spot (1 cm grid) nearest the
+        object and then the goal."""
         if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self._spoiled(*cur[:2]):
             return float(cur[0]), float(cur[1])
         ws = self.workspace

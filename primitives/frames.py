@@ -34,12 +34,18 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from scipy.special import expit, logit
 
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives.env import OBS_DIM, SkillObservation
 
 MIRROR_Y = np.diag([1.0, -1.0, 1.0])
+
+
+def rating_logit(p: np.ndarray | float) -> np.ndarray:
+    """``logit(p)`` of success ratings, clipped to ``[1e-6, 1 - 1e-6]`` first (a rating of 0 or 1 stays finite)."""
+    return logit(np.clip(np.asarray(p, dtype=float), 1e-6, 1.0 - 1e-6))
 
 
 def free_frames(skill: str, params: dict | None, n_turns: int, mirror: bool) -> np.ndarray:
@@ -106,11 +112,12 @@ class FrameSearch:
     def frames(self, skill: str, params: dict | None) -> np.ndarray:
         return free_frames(skill, params, self.turns, bool(self.mirror))
 
-    def calibrate(self, p: np.ndarray | float, parameterised: bool = True) -> np.ndarray:
-        """The calibrated probability of the best ratings ``p`` of requests with (or without) a parameter."""
-        p = np.clip(np.asarray(p, dtype=float), 1e-6, 1.0 - 1e-6)
-        a, b = self.platt if parameterised else self.platt_unparameterised
-        return 1.0 / (1.0 + np.exp(-(a * np.log(p / (1.0 - p)) + b)))
+    def calibrate(self, p: np.ndarray | float, parameterised: np.ndarray | bool = True) -> np.ndarray:
+        """The calibrated probability of the best ratings ``p`` of requests with (or without) a parameter;
+        ``parameterised`` is one flag for all, or one per rating."""
+        (a, b), (a0, b0) = self.platt, self.platt_unparameterised
+        par = np.asarray(parameterised, dtype=bool)
+        return expit(np.where(par, a, a0) * rating_logit(p) + np.where(par, b, b0))
 
     def save(self, path: str | os.PathLike) -> None:
         d = asdict(self)

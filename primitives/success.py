@@ -222,8 +222,9 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
 
 def fit_frame_calibration(rating: np.ndarray, success: np.ndarray) -> tuple[float, float]:
     """``(a, b)`` of the Platt scaling ``sigmoid(a logit(p) + b)`` of the chosen frames' ratings ``p``."""
-    p = np.clip(np.asarray(rating, dtype=float), 1e-6, 1.0 - 1e-6)
-    z = torch.from_numpy(np.log(p / (1.0 - p)).astype(np.float32))
+    from primitives.frames import rating_logit
+
+    z = torch.from_numpy(rating_logit(rating).astype(np.float32))
     a, b = _platt(z, torch.from_numpy(np.asarray(success, dtype=np.float32))).tolist()
     return float(a), float(b)
 
@@ -481,7 +482,7 @@ def _run_frames(args: argparse.Namespace) -> int:
     platt = fit_frame_calibration(rating[par], success[par])
     platt_seed = fit_frame_calibration(rating[~par], success[~par]) if (~par).sum() >= 50 else (1.0, 0.0)
     search = FrameSearch(search.turns, search.mirror, platt, platt_seed)
-    p = np.where(par, search.calibrate(rating, True), search.calibrate(rating, False))
+    p = search.calibrate(rating, par)
     info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped",
                 model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
                 frames_seed_objective=len(search.frames(args.skill, None)), minutes=(time.perf_counter() - t0) / 60,
@@ -505,7 +506,7 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
         raise InputError(f"no frame search is shipped for {args.skill}")
     rating, success, par = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
                                                 seed=args.seed, progress=not args.json)
-    p = np.where(par, search.calibrate(rating, True), search.calibrate(rating, False))
+    p = search.calibrate(rating, par)
     result = dict(skill=args.skill, objects="test split (never trained on)", frames=args.frames,
                   all=metrics(p, success), parameterised=metrics(p[par], success[par]),
                   seed_objective=metrics(p[~par], success[~par]) if (~par).any() else None)

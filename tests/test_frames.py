@@ -63,6 +63,8 @@ def test_frame_search_calibration_and_files(tmp_path):
     q = search.calibrate(p)
     assert np.all(np.diff(q) > 0) and q[1] == pytest.approx(1 / (1 + math.exp(0.3)))
     assert search.calibrate(0.5, parameterised=False) == pytest.approx(1 / (1 + math.exp(1.0)))
+    mixed = search.calibrate(p, np.array([True, False, True]))  # one flag per rating
+    assert mixed[0] == q[0] and mixed[2] == q[2] and mixed[1] == pytest.approx(1 / (1 + math.exp(1.0)))
     assert np.allclose(FrameSearch().calibrate(p), p)
     search.save(tmp_path / "f.json")
     back = FrameSearch.load(tmp_path / "f.json")
