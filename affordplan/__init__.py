@@ -37,7 +37,24 @@ def plan(obj, goal, *, start=None, obstacles=(), time_limit=5.0, planner="afford
     return _plan(obj, goal, start=start, obstacles=obstacles, time_limit=time_limit, planner=planner, seed=seed,
                  **kwargs)
 
-__version__ = "0.1.0"
+__version__ = "0.8.0"
+
+
+def versions() -> dict[str, str]:
+    """Versions of affordplan and of the libraries its figures depend on (physics, learning, planning).
+
+    Benchmarks print them: the same weights and seeds give other figures under another MuJoCo release.
+    """
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"affordplan": __version__}
+    for name in ("mujoco", "torch", "ompl", "mink", "python-fcl", "numpy"):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
 
 __all__ = [
     "Box",
@@ -51,5 +68,6 @@ __all__ = [
     "errors",
     "load_object",
     "plan",
+    "versions",
     "random_object",
 ]

@@ -206,6 +206,13 @@ def _register_robustness(bench_sub) -> None:
     robustness.register_cli(bench_sub)
 
 
+def _version_line() -> str:
+    from affordplan import versions
+
+    v = versions()
+    return f"affordplan {v.pop('affordplan')} (" + ", ".join(f"{k} {x}" for k, x in v.items()) + ")"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="affordplan",
@@ -214,6 +221,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=EXAMPLES,
         formatter_class=_formatter,
     )
+    parser.add_argument("--version", action="version", version=_version_line(),
+                        help="print affordplan's version and those of the libraries its figures depend on")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     demo = sub.add_parser(

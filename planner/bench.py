@@ -20,6 +20,7 @@ import networkx as nx
 import numpy as np
 from tqdm import tqdm
 
+from affordplan import versions
 from affordplan.errors import AffordplanError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel, random_object
@@ -65,7 +66,8 @@ class BenchReport:
                                       for s in sorted({r.scene for r in rs})})
 
     def report(self) -> str:
-        lines = [f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median)':>19s} "
+        lines = ["versions: " + ", ".join(f"{k} {v}" for k, v in versions().items()),
+                 f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median)':>19s} "
                  f"{'primitives/task':>16s} {'replans/task':>13s}  by scene"]
         for name in dict.fromkeys(r.planner for r in self.results):
             s = self.summary(name)
@@ -76,7 +78,8 @@ class BenchReport:
 
     def as_dict(self) -> dict:
         names = list(dict.fromkeys(r.planner for r in self.results))
-        return dict(summary=[self.summary(n) for n in names], tasks=[asdict(r) for r in self.results])
+        return dict(versions=versions(), summary=[self.summary(n) for n in names],
+                    tasks=[asdict(r) for r in self.results])
 
 
 def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...]:

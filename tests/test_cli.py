@@ -129,6 +129,19 @@ def test_cli_help_has_examples(capsys):
     assert all(name in out for name in ("demo", "plan", "render", "affordances", "bench"))
 
 
+def test_version_names_the_physics_and_learning_libraries(capsys):
+    import mujoco
+
+    import affordplan
+
+    with pytest.raises(SystemExit) as info:
+        cli.main(["--version"])
+    assert info.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"affordplan {affordplan.__version__} (") and f"mujoco {mujoco.__version__}" in out
+    assert "torch " in out and "ompl " in out
+
+
 @pytest.mark.parametrize("argv", SUBCOMMANDS, ids=" ".join)
 def test_every_subcommand_help_shows_an_example(argv, capsys):
     with pytest.raises(SystemExit) as info:
