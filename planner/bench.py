@@ -1,6 +1,7 @@
 """``affordplan bench plan``: random plan-and-execute tasks, affordplan against the greedy baseline.
 
-Each task draws an object from the procedural *test* split (never trained on), a scene (a wall with
+Each task draws an object from the procedural *test* split (never trained on; task ``i`` of seed ``S`` takes
+object ``OBJECTS_PER_SEED * S + i``, so each seed meets other objects), a scene (a wall with
 a gap between start and goal, two or three blocks, or an open table), a start (resting state by its
 probability, position on the near side, random yaw) and a goal (the far side; a different resting
 state in 40 % of tasks; a goal yaw in half of them). Every task can be solved in principle: the start and
@@ -28,6 +29,9 @@ from affordplan.world import Box, Workspace
 from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, inflated_footprints, make_checkers
 from planner.predict import Predictor
+
+# seed S's tasks take test objects 1000 S, 1000 S + 1, ... (until release 0.7: objects 0-49 for every seed)
+OBJECTS_PER_SEED = 1000
 
 
 @dataclass
@@ -98,7 +102,7 @@ def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...
 
 
 def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Workspace()) -> tuple[Task, ObjectModel]:
-    """A random task whose start and goal are free (resampled until they are)."""
+    """A random task on test object ``index`` whose start and goal are free (resampled until they are)."""
     obj = random_object(index, "test")
     states = obj.resting_states
     probs = np.array([s.probability for s in states])
@@ -123,7 +127,7 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
         if checker[s0].is_free(*start["xy"], start["yaw"]) and \
                 any(checker[goal_state].is_free(*goal.xy, a) for a in yaws):
             return Task(index, kind, obstacles, start, goal), obj
-    raise AffordplanError(f"could not place a free start and goal for task {index}")
+    raise AffordplanError(f"could not place a free start and goal on test object {index}")
 
 
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
@@ -147,7 +151,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     rng = np.random.default_rng(seed)
     report = BenchReport()
     for i in tqdm(range(n_tasks), desc=f"bench plan ({sim})", disable=not progress, unit="task"):
-        task, obj = make_task(rng, i)
+        task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)
         predictor = Predictor(obj, seed=seed)
         for name in planners:
             report.results.append(run_task(task, obj, name, sim, predictor, seed + i, max_primitives, time_limit))
