@@ -68,6 +68,6 @@ __all__ = [
     "errors",
     "load_object",
     "plan",
-    "versions",
     "random_object",
+    "versions",
 ]

@@ -22,7 +22,7 @@ import numpy as np
 from tqdm import tqdm
 
 from affordplan import versions
-from affordplan.errors import AffordplanError
+from affordplan.errors import AffordplanError, InputError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel, random_object
 from affordplan.world import Box, Workspace
@@ -148,6 +148,9 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring)."""
+    if not 0 < n_tasks <= OBJECTS_PER_SEED:
+        raise InputError(f"n_tasks must be 1-{OBJECTS_PER_SEED} (seed S's tasks take test objects "
+                         f"{OBJECTS_PER_SEED} S + i), got {n_tasks}")
     rng = np.random.default_rng(seed)
     report = BenchReport()
     for i in tqdm(range(n_tasks), desc=f"bench plan ({sim})", disable=not progress, unit="task"):

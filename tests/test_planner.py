@@ -448,6 +448,16 @@ def test_bench_tasks_can_be_solved_in_principle():
         assert g == s or nx.has_path(RestingStateGraph(obj, lambda a, b: 1.0).graph, s, g)
 
 
+def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
+    from affordplan.errors import InputError
+    from planner.bench import OBJECTS_PER_SEED, bench_plan, make_task
+
+    _, obj = make_task(np.random.default_rng(3), OBJECTS_PER_SEED * 3 + 7)
+    assert obj.name.startswith(f"test_{OBJECTS_PER_SEED * 3 + 7}_")
+    with pytest.raises(InputError, match="n_tasks"):
+        bench_plan(OBJECTS_PER_SEED + 1, seed=0, progress=False)
+
+
 def test_a_primitive_refused_before_any_physics_ends_the_execution():
     """A guard that flags the resting pose itself would refuse every later primitive: stop, do not loop."""
     from types import SimpleNamespace
