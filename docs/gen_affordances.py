@@ -39,6 +39,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--trials", type=int, default=5, help="starts per action (default: 5)")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
+    if args.trials < 1:
+        ap.error(f"--trials must be at least 1, got {args.trials}")
 
     discussion = ""
     if OUT.exists() and DISCUSSION in (old := OUT.read_text()):
