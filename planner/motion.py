@@ -73,6 +73,8 @@ class FootprintChecker:
             the caller wants (see :func:`planner.footprint.inflate`); its convex hull is used.
         obstacles: boxes standing on the table (world frame).
         workspace: the region every footprint vertex must stay in (world frame).
+        reach: when given, every footprint vertex must also lie within this many metres of the world origin
+            (the arm's base): where the fingertip can reach all round the object.
 
     Poses are the object-centred origin's world ``(x, y)`` in metres and the yaw about world z in
     radians (:func:`planner.footprint.place`). Queries update one fcl object's transform; obstacles whose
@@ -80,7 +82,8 @@ class FootprintChecker:
     from the obstacles and the workspace edge, ~3.5 us per obstacle within reach.
     """
 
-    def __init__(self, footprint: np.ndarray, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace()):
+    def __init__(self, footprint: np.ndarray, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
+                 reach: float | None = None):
         polygon = convex_hull_2d(as_polygon(footprint, "footprint"))
         obstacles = tuple(obstacles)
         for i, box in enumerate(obstacles):
@@ -88,9 +91,12 @@ class FootprintChecker:
                 raise InputError(f"obstacle {i} must be an affordplan.world.Box, got {type(box).__name__}")
         if not isinstance(workspace, Workspace):
             raise InputError(f"workspace must be an affordplan.world.Workspace, got {type(workspace).__name__}")
+        if reach is not None and not (math.isfinite(reach) and reach > 0.0):
+            raise InputError(f"reach must be a positive number of metres or None, got {reach!r}")
         self.footprint = polygon
         self.obstacles = obstacles
         self.workspace = workspace
+        self.reach = reach
         self._px = polygon[:, 0].copy()
         self._py = polygon[:, 1].copy()
         self._radius = float(np.max(np.hypot(self._px, self._py)))  # circumscribed about the origin
@@ -121,15 +127,18 @@ class FootprintChecker:
         self._object.setTranslation(t)
 
     def in_workspace(self, x: float, y: float, yaw: float) -> bool:
-        """Whether every footprint vertex at pose ``(x, y, yaw)`` lies in the workspace (boundary included)."""
+        """Whether every footprint vertex at pose ``(x, y, yaw)`` lies in the workspace (boundary included),
+        and within ``reach`` of the origin when one is set."""
         x0, x1, y0, y1 = self._inner
-        if x0 <= x <= x1 and y0 <= y <= y1:
+        within_reach = self.reach is None or math.hypot(x, y) + self._radius <= self.reach
+        if x0 <= x <= x1 and y0 <= y <= y1 and within_reach:
             return True
         c, s = math.cos(yaw), math.sin(yaw)
         xs = c * self._px - s * self._py + x
         ys = s * self._px + c * self._py + y
         ws = self.workspace
-        return bool(xs.min() >= ws.x[0] and xs.max() <= ws.x[1] and ys.min() >= ws.y[0] and ys.max() <= ws.y[1])
+        inside = xs.min() >= ws.x[0] and xs.max() <= ws.x[1] and ys.min() >= ws.y[0] and ys.max() <= ws.y[1]
+        return bool(inside and (within_reach or np.max(xs * xs + ys * ys) <= self.reach * self.reach))
 
     def colliding(self, x: float, y: float, yaw: float, *, first: bool = False) -> list[int]:
         """Indices of the obstacles the footprint at ``(x, y, yaw)`` overlaps (only the first if ``first``)."""
@@ -161,7 +170,8 @@ class FootprintChecker:
         reasons = []
         if not self.in_workspace(x, y, yaw):
             ws = self.workspace
-            reasons.append(f"the footprint leaves the workspace (x in {list(ws.x)}, y in {list(ws.y)} m)")
+            reach = "" if self.reach is None else f", within {self.reach} m of the arm's base"
+            reasons.append(f"the footprint leaves the workspace (x in {list(ws.x)}, y in {list(ws.y)} m{reach})")
         hits = self.colliding(x, y, yaw)
         if hits:
             names = ", ".join(f"{i} ({self.obstacles[i]})" for i in hits)

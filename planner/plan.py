@@ -16,7 +16,12 @@
 Failures reported back (:meth:`Planner.record_failure`) down-weight what failed: a roll edge in the
 graph, or a push direction (relative to the object) / spin sense in a resting state, which the next
 plan then avoids (a push is split into two pushes 35 deg to either side); a place where rolls failed
-twice is not rolled at again (the object is pushed to the nearest other room first).
+twice is not rolled at again (the object is pushed to the nearest other room first). A push whose
+fingertip would come down on an obstacle is split the same way from the start.
+
+The arm reaches so far (``reach``, from its base at the world origin): footprints stay where the fingertip
+can get all round them, and spins, which shift objects by up to their own size, happen where such a shift
+still leaves the object within reach (the turn is moved to such a spot when the path's own is not).
 """
 
 from __future__ import annotations
@@ -33,9 +38,11 @@ from affordplan.errors import GoalError, PlanningError
 from affordplan.geometry import wrap_angle
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
+from affordplan.sim.arm import FINGERTIP_REACH, TIP_RADIUS
+from affordplan.sim.simulator import Protocol
 from affordplan.world import Box, Workspace
 from planner import chain
-from planner.footprint import footprint, inflate
+from planner.footprint import footprint, inflate, place
 from planner.graph import RestingStateGraph
 from planner.motion import FootprintChecker, plan_path
 from planner.predict import Predictor, expected_pose, state_pose
@@ -62,6 +69,24 @@ ROLL_SPOT_FAILURES = 2
 ROLL_SPOT_RADIUS = 0.04
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
+# Metres from the arm's base (the world origin) that an inflated footprint must stay within, so that the
+# fingertip can get behind the object from every side: its pre-contact point lies about 2.5 cm beyond the
+# inflated footprint (4 cm standoff and the 0.8 cm tip, less the 2 cm clearance, on a flat side; less on a
+# corner) and must be within FINGERTIP_REACH. Without it, a die spun or pushed 7 cm past its goal at
+# x = 0.68 m could no longer be pushed back: every contact on its far side was out of reach.
+ARM_REACH = FINGERTIP_REACH - 0.025  # 0.79 m
+# How far a spin is taken to shift an object, in multiples of its radius (Planner.spin_room). Measured (arm sim,
+# shipped spin, 25-35 deg): 16 spins of the 10 cm cube shifted it 2.4-7.1 cm, median 6.4 cm, for a radius of
+# 7.1 cm; 10 of the mug 2.4-4.3 cm, median 3.2 cm, for a radius of 6.1 cm. A whole radius (the worst seen) cost
+# a large frustum its goal 0.65 m out on bench seed 0 (0.90 against 0.92); half of it and none scored alike
+# on seeds 0 and 1 (0.92, 0.84), and half still keeps the die's turns off its goal 0.68 m out.
+SPIN_DRIFT = 0.5
+FREE_YAW_STEPS = np.radians([0.0] + [sign * a for a in range(5, 180, 5) for sign in (1, -1)] + [180.0])
+FREE_SEARCH_SLACK = 0.02  # metres past the nearest free position that _nearest_free looks for a better one
+TURN_SPOT_MOVE_COST = 0.05  # metres of path a turn spot other than the object's own place must save (_turn_spot)
+# Radius (metres) of the disc kept clear of obstacles where the fingertip comes down behind an object to push
+# it (Planner.push_blocked): the tip's, plus a margin.
+FINGER_ROOM = TIP_RADIUS + 0.006
 
 
 @dataclass
@@ -104,12 +129,13 @@ def inflated_footprints(obj: ObjectModel, clearance: float) -> dict[int, np.ndar
 
 
 def make_checkers(footprints: dict[int, np.ndarray], obstacles: Sequence[Box],
-                  workspace: Workspace) -> dict[int, FootprintChecker]:
-    """One checker per resting state. The object's centre must stay in the workspace; its (inflated)
-    footprint may overhang it by ``WORKSPACE_OVERHANG``."""
+                  workspace: Workspace, reach: float | None = None) -> dict[int, FootprintChecker]:
+    """One checker per resting state. The object's centre stays in the workspace (the bounds of the SE(2)
+    space the paths are planned in); its (inflated) footprint may overhang it by
+    ``WORKSPACE_OVERHANG``, and must stay within ``reach`` metres of the arm's base when that is given."""
     m = WORKSPACE_OVERHANG
     grown = Workspace((workspace.x[0] - m, workspace.x[1] + m), (workspace.y[0] - m, workspace.y[1] + m))
-    return {i: FootprintChecker(fp, obstacles, grown) for i, fp in footprints.items()}
+    return {i: FootprintChecker(fp, obstacles, grown, reach) for i, fp in footprints.items()}
 
 
 class Planner:
@@ -124,11 +150,13 @@ class Planner:
         seed: seeds OMPL and the predictor.
         clearance: metres the footprint is grown by (room for the fingertip beside the object).
         roll_margin: metres around a roll spot kept clear for the displacement a roll causes.
+        reach: metres from the arm's base (the world origin) that the inflated footprints stay within, and
+            within which spins are placed with room to drift (:meth:`spin_room`); ``None``: no arm to reach.
     """
 
     def __init__(self, obj: ObjectModel, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
                  predictor: Predictor | None = None, time_limit: float = 5.0, seed: int = 0,
-                 clearance: float = CLEARANCE, roll_margin: float = 0.04):
+                 clearance: float = CLEARANCE, roll_margin: float = 0.04, reach: float | None = ARM_REACH):
         self.obj = obj
         self.obstacles = tuple(obstacles)
         self.workspace = workspace
@@ -141,8 +169,14 @@ class Planner:
         self.failed_roll_spots: list[tuple[float, float]] = []  # (x, y) of every failed roll, metres
         self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
         self._spin_rates: dict[tuple[int, int], np.ndarray] = {}  # (state, sense) -> P(spin) over SPIN_RATE_GRID
+        self.reach = reach
         self.footprints = inflated_footprints(obj, clearance)
-        self.checkers = make_checkers(self.footprints, self.obstacles, workspace)
+        self._shadows = {s.index: footprint(obj, s.index) for s in obj.resting_states}  # not inflated
+        finger = FINGER_ROOM * np.stack([np.cos(np.linspace(0, 2 * np.pi, 8, endpoint=False)),
+                                         np.sin(np.linspace(0, 2 * np.pi, 8, endpoint=False))], axis=1)
+        self._finger = FootprintChecker(finger, self.obstacles, Workspace((-2.0, 2.0), (-2.0, 2.0)))
+        self._standoff = Protocol().standoff
+        self.checkers = make_checkers(self.footprints, self.obstacles, workspace, reach)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
         self.graph = RestingStateGraph(obj, self._roll_probability)
         self._calls = 0
@@ -167,7 +201,31 @@ class Planner:
         return self.failures[failure_key(self.obj, skill, params, T)]
 
     def _avoided(self, skill: str, params: dict, T: np.ndarray) -> bool:
+        """Whether the plan goes round this call: it failed twice, or (a push) the fingertip has no way in."""
+        if skill == "push" and self.push_blocked(T, params["direction"]):
+            return True
         return self._failed(skill, params, T) >= FAILURES_TO_AVOID
+
+    def push_blocked(self, T_world_object: np.ndarray, direction: float) -> bool:
+        """Whether an obstacle stands where the fingertip must come down to push the object (at its settled
+        pose ``T_world_object``) along ``direction`` (radians, world): behind the object, on the line through
+        its centre, at the skill's standoff and half-way in (a disc of ``FINGER_ROOM``).
+
+        The footprint's 2 cm clearance keeps paths off obstacles but not always room for the finger on the
+        side a push needs: a die squeezed past a block, pushed away from it, was pushed at nothing and did not
+        move, twice per direction, before the failure memory sent the plan round.
+        """
+        if not self.obstacles:
+            return False
+        state, x, y, yaw = self.obj.planar_pose(T_world_object)
+        d = np.array([math.cos(direction), math.sin(direction)])
+        shadow = place(self._shadows[state], x, y, yaw)
+        back = float(np.max((shadow - (x, y)) @ -d))  # how far the object reaches behind its centre
+        for gap in (0.5 * self._standoff, self._standoff):
+            px, py = np.array([x, y]) - (back + TIP_RADIUS + gap) * d
+            if not self._finger.is_free(float(px), float(py), 0.0):
+                return True
+        return False
 
     def check_goal(self, goal: Goal, start_state: int) -> int:
         """The goal's resting state; raises :class:`GoalError` for goals that cannot be met."""
@@ -200,10 +258,6 @@ class Planner:
         calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
         paths: list[tuple[int, np.ndarray]] = []
         cur = (x, y, yaw)
-        if not self.checkers[state].is_free(*cur):  # pushed into a tight spot: push it out first
-            free = self._nearest_free(state, cur)
-            calls.append((state, "push", {"direction": math.atan2(free[1] - y, free[0] - x)}, (*free, yaw)))
-            cur = (*free, yaw)
         for k, (a, b) in enumerate(zip(route, route[1:])):
             spot = self._roll_spot(a, b, cur, goal)
             want_yaw = cur[2]
@@ -211,9 +265,8 @@ class Planner:
             if turn and last_roll and self._turns_better(a, goal_state):
                 want_yaw = self._yaw_before_roll(a, b, spot, goal, cur[2])  # turn here, arrive turned
             spot_yaw = self._free_yaw(a, spot, want_yaw)
-            path = self._path(a, cur, (*spot, spot_yaw), deadline)
-            paths.append((a, path))
-            segment = chain.path_to_calls(path, is_free=self.checkers[a].is_free, spin_rate=self._spin_rate(a))
+            segment_paths, segment = self._segment(a, cur, (*spot, spot_yaw), deadline)
+            paths += [(a, path) for path in segment_paths]
             calls += [(a, *c) for c in segment]
             if segment:
                 cur = segment[-1][2]
@@ -223,22 +276,86 @@ class Planner:
             calls.append((a, "roll", {"target": b}, (ax, ay, ayaw)))
             cur = (ax, ay, ayaw)
         goal_yaw = goal.yaw_near(self.obj, goal_state, cur[2]) if turn else self._free_yaw(goal_state, goal.xy, cur[2])
-        path = self._path(goal_state, cur, (*goal.xy, goal_yaw), deadline)
-        paths.append((goal_state, path))
-        calls += [(goal_state, *c) for c in chain.path_to_calls(path, goal_yaw if turn else None,
-                                                                 is_free=self.checkers[goal_state].is_free,
-                                                                 spin_rate=self._spin_rate(goal_state))]
+        segment_paths, segment = self._segment(goal_state, cur, (*goal.xy, goal_yaw), deadline,
+                                               goal_yaw if turn else None)
+        paths += [(goal_state, path) for path in segment_paths]
+        calls += [(goal_state, *c) for c in segment]
         steps = self._steps(state, (x, y, yaw), calls)
         p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
         self._calls += 1
         return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
                     goal=goal, start_pose=np.array(T_start), planner=self)
 
+    def _segment(self, state: int, start, end, deadline: float,
+                 final_yaw: float | None = None) -> tuple[list[np.ndarray], list[chain.Call]]:
+        """Paths and calls from ``start`` to ``end`` (x, y, yaw) in resting state ``state``; spins to
+        ``final_yaw`` at the end when given.
+
+        Where the start is not free (the object was pushed into a tight spot, or a roll is expected to leave it
+        there), it is first pushed to the nearest free place (:meth:`_nearest_free`). Where the calls would
+        spin the object without room to drift (:meth:`spin_room`), the turn is made at a spot that has it
+        (:meth:`_turn_spot`): push there at the start's yaw, turn, push on at the end's.
+        """
+        def calls_for(path: np.ndarray, yaw: float | None) -> list[chain.Call]:
+            return chain.path_to_calls(path, yaw, is_free=self.checkers[state].is_free,
+                                       spin_rate=self._spin_rate(state))
+
+        out: list[chain.Call] = []
+        if not self.checkers[state].is_free(*start):
+            free = self._nearest_free(state, start, end)
+            out.append(("push", {"direction": math.atan2(free[1] - start[1], free[0] - start[0])}, (*free, start[2])))
+            start = (*free, start[2])
+        path = self._path(state, start, end, deadline)
+        calls = calls_for(path, final_yaw)
+        if all(self.spin_room(state, *after[:2]) for skill, _, after in calls if skill == "spin"):
+            return [path], out + calls
+        spot = self._turn_spot(state, start, end)
+        if spot is None:
+            return [path], out + calls
+        to_spot = self._path(state, start, (*spot, start[2]), deadline)
+        from_spot = self._path(state, (*spot, end[2]), end, deadline)
+        return [to_spot, from_spot], out + calls_for(to_spot, end[2]) + calls_for(from_spot, final_yaw)
+
+    def spin_room(self, state: int, x: float, y: float) -> bool:
+        """Whether the object (in ``state``, centred at ``(x, y)``) may be spun there: its inflated footprint
+        stays within ``reach`` after a drift of ``SPIN_DRIFT`` times its own radius, so that it can still be
+        pushed back from every side. Always, without ``reach``."""
+        if self.reach is None:
+            return True
+        drift = SPIN_DRIFT * (self.radius[state] - self.clearance)
+        return math.hypot(x, y) + self.radius[state] + drift <= self.reach
+
+    def _turn_spot(self, state: int, start, end) -> tuple[float, float] | None:
+        """Where to turn from ``start``'s yaw to ``end``'s when the path's own turn has no room to drift.
+
+        The start itself where it has room to spin (:meth:`spin_room`) and is free at both yaws and half-way;
+        else the place (1 cm grid over the workspace) that has, with the shortest way from the start through
+        it to the end, plus ``TURN_SPOT_MOVE_COST`` for moving at all: a spot a push short of the start would
+        be overshot (pushes move 5-9 cm) and pushed back to, over and over. ``None`` where there is none.
+        """
+        checker = self.checkers[state]
+        yaws = (start[2], end[2], start[2] + 0.5 * float(wrap_angle(end[2] - start[2])))
+
+        def room(px: float, py: float) -> bool:
+            return self.spin_room(state, px, py) and all(checker.is_free(px, py, a) for a in yaws)
+
+        ws = self.workspace
+        if room(start[0], start[1]):
+            return float(start[0]), float(start[1])
+        best, best_cost = None, math.inf
+        for px in np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01):
+            for py in np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01):
+                cost = (math.hypot(px - end[0], py - end[1]) + math.hypot(px - start[0], py - start[1])
+                        + TURN_SPOT_MOVE_COST)
+                if cost < best_cost and room(px, py):
+                    best, best_cost = (float(px), float(py)), cost
+        return best
+
     def _steps(self, state: int, start: tuple[float, float, float], calls) -> list[Step]:
         steps: list[Step] = []
         T = state_pose(self.obj, state, *start)
         for call_state, skill, params, after in calls:
-            if skill == "push" and self._avoided(skill, params, T):  # go round the failing direction
+            if skill == "push" and self._avoided(skill, params, T):  # go round a failing or blocked direction
                 for direction in self._detour(params["direction"], T):
                     p = {"direction": direction}
                     T_next = expected_pose(self.obj, "push", p, T)
@@ -333,23 +450,34 @@ class Planner:
         return float(wrap_angle(goal.yaw_near(self.obj, b, yaw + offset) - offset))
 
     def _detour(self, direction: float, T: np.ndarray) -> list[float]:
-        """Pushes that stand in for a push along ``direction`` (radians) that failed twice from pose ``T``.
+        """Pushes that stand in for a push along ``direction`` (radians) from pose ``T`` that is avoided: it
+        failed twice, or the fingertip has no way in (:meth:`push_blocked`).
 
-        One push on each side of it, turned by the smallest of :data:`DETOUR_ANGLES` whose own direction has
-        not failed twice (the pair's sum still heads the same way when both turns are equal). A side where
-        every turn has failed is left out; when both are, the least-failed of all turns is tried.
+        One push on each side of it, turned by the smallest of :data:`DETOUR_ANGLES` whose own direction is not
+        avoided and whose push, from ``T``, would leave the object where it may be (its footprint checker:
+        clear of obstacles, within reach); the pair's sum still heads the same way when both turns are equal.
+        A side where no turn qualifies is left out; when both are, the best of all turns (unblocked, not failed
+        twice, landing free, least failed) is tried: a cylinder beside a block was otherwise pushed 36 times the
+        one way that landed free, and never moved.
         """
+        state = self.obj.classify(T)
+
+        def lands_free(d: float) -> bool:
+            _, x, y, yaw = self.obj.planar_pose(expected_pose(self.obj, "push", {"direction": d}, T))
+            return self.checkers[state].is_free(x, y, yaw)
+
         pushes = []
         for sign in (1.0, -1.0):
             for turn in DETOUR_ANGLES:
                 d = float(wrap_angle(direction + sign * turn))
-                if not self._avoided("push", {"direction": d}, T):
+                if not self._avoided("push", {"direction": d}, T) and lands_free(d):
                     pushes.append(d)
                     break
         if pushes:
             return pushes
         turns = [float(wrap_angle(direction + sign * t)) for t in DETOUR_ANGLES for sign in (1.0, -1.0)]
-        return [min(turns, key=lambda d: self._failed("push", {"direction": d}, T))]
+        return [min(turns, key=lambda d: (self.push_blocked(T, d), self._avoided("push", {"direction": d}, T),
+                                          not lands_free(d), self._failed("push", {"direction": d}, T)))]
 
     def _path(self, state: int, start, goal, deadline: float) -> np.ndarray:
         left = deadline - time.perf_counter()
@@ -374,20 +502,39 @@ class Planner:
         return bool(p_goal >= p_start)
 
     def _free_yaw(self, state: int, xy, prefer: float) -> float:
+        """The yaw nearest ``prefer`` (5 deg steps either way, all round) at which ``state`` is free at ``xy``.
+
+        All round: an object near the arm's reach may be free at a few yaws only (the goal check found one).
+        """
         checker = self.checkers[state]
-        for d in np.radians([0, 15, -15, 30, -30, 45, -45, 60, -60, 90, -90, 120, -120, 150, -150, 180]):
+        for d in FREE_YAW_STEPS:
             if checker.is_free(xy[0], xy[1], prefer + d):
                 return float(wrap_angle(prefer + d))
         raise PlanningError(f"no free orientation of resting state {state} at {tuple(np.round(xy, 3))}")
 
-    def _nearest_free(self, state: int, cur) -> tuple[float, float]:
-        """The nearest position (5 mm grid) where the footprint is free at the current yaw."""
+    def _nearest_free(self, state: int, cur, toward) -> tuple[float, float]:
+        """Where to push an object that is not free at ``cur`` (x, y, yaw), at its yaw: of the free positions
+        (5 mm rings) at most ``FREE_SEARCH_SLACK`` farther than the nearest, one the push to which is not avoided
+        (:meth:`_avoided`: no room for the fingertip, or failed twice), and of those the one nearest ``toward``
+        (x, y: where the segment goes). A die
+        pressed against a block, its goal along the block, was pushed off it on the side nearest by a hair,
+        away from the goal and out of the arm's reach."""
+        T = state_pose(self.obj, state, *cur)
+        found: list[tuple[bool, float, float, float]] = []  # (avoided, distance to toward, x, y)
+        first = None
         for r in np.arange(0.005, 0.3, 0.005):
+            if first is not None and r > first + FREE_SEARCH_SLACK:
+                break
             for a in np.linspace(-math.pi, math.pi, max(8, int(2 * math.pi * r / 0.005)), endpoint=False):
                 px, py = cur[0] + r * math.cos(a), cur[1] + r * math.sin(a)
                 if self.checkers[state].is_free(px, py, cur[2]):
-                    return float(px), float(py)
-        raise PlanningError(f"the object is stuck at {tuple(np.round(cur[:2], 3))}: no free position nearby")
+                    first = r if first is None else first
+                    found.append((self._avoided("push", {"direction": float(a)}, T),
+                                  math.hypot(px - toward[0], py - toward[1]), float(px), float(py)))
+        if not found:
+            raise PlanningError(f"the object is stuck at {tuple(np.round(cur[:2], 3))}: no free position nearby")
+        _, _, px, py = min(found)
+        return px, py
 
     def _roll_spot(self, a: int, b: int, cur, goal: Goal) -> tuple[float, float]:
         """Nearest place where a roll from state ``a`` to ``b`` has room.

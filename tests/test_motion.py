@@ -106,6 +106,22 @@ def test_checker_flags_workspace_exits(cube):
     assert checker.clearance(0.5, 0.0, 0.0) == math.inf
 
 
+def test_checker_keeps_the_footprint_within_the_arms_reach(cube):
+    """With ``reach``, every vertex of the 10 cm square must lie within that distance of the base (origin)."""
+    checker = FootprintChecker(footprint(cube, 0), (), WORKSPACE, reach=0.7)
+    assert checker.is_free(0.64, 0.0, 0.0)  # far side at x = 0.69
+    assert not checker.is_free(0.66, 0.0, 0.0)  # far side at x = 0.71
+    assert not checker.is_free(0.635, 0.0, math.pi / 4)  # turned, a corner 7.1 cm out: at x = 0.706
+    assert checker.is_free(0.62, 0.0, math.pi / 4)
+    wide = FootprintChecker(footprint(cube, 0), (), ap.Workspace(x=(0.3, 0.9), y=(-0.5, 0.5)), reach=0.7)
+    assert wide.is_free(0.45, 0.4, 0.0)  # the far corner (0.5, 0.45) is 0.673 m from the base
+    assert not wide.is_free(0.5, 0.45, 0.0)  # the far corner (0.55, 0.5) is 0.743 m from it
+    assert "within 0.7 m of the arm's base" in checker.why_not_free(0.66, 0.0, 0.0)
+    assert FootprintChecker(footprint(cube, 0), (), WORKSPACE).is_free(0.66, 0.0, 0.0)  # no reach: no limit
+    with pytest.raises(InputError):
+        FootprintChecker(footprint(cube, 0), (), WORKSPACE, reach=-1.0)
+
+
 def test_checker_agrees_with_a_separating_axis_test(pill_bottle):
     fp = inflate(footprint(pill_bottle, 0), 0.005)
     boxes = [ap.Box(center=(0.5, 0.0), size=(0.1, 0.03, 0.1), yaw=0.7),

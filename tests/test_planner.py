@@ -72,6 +72,17 @@ def test_graph_prefers_the_likelier_route():
     assert len(graph.route(0, opposite)) == 3  # the opposite face takes two rolls
 
 
+def test_graph_takes_the_fewest_rolls_when_the_model_rates_them_all_near_certain():
+    """Rolls rated 0.996 and 0.988 are all capped at MAX_PROBABILITY: one roll beats three."""
+    from planner.graph import MAX_PROBABILITY
+
+    cube = ap.load_object("cube")
+    direct = skill_params.roll_targets(cube, 0)[0]
+    graph = RestingStateGraph(cube, lambda i, j: 0.988 if (i, j) == (0, direct) else 0.996)
+    assert graph.route(0, direct) == [0, direct]
+    assert graph.probability(0, direct) == MAX_PROBABILITY
+
+
 def test_path_through_the_gap_is_collision_free():
     cube = ap.load_object("cube")
     planner = _planner(cube, WALL_WITH_GAP)
@@ -223,6 +234,48 @@ def test_a_place_where_rolls_failed_twice_is_left_for_another():
     assert math.hypot(where[-1][0] - 0.45, where[-1][1]) > 0.04
 
 
+def test_turns_near_the_reach_edge_are_made_where_a_drift_can_still_be_pushed_back():
+    """A 10 cm cube 1 cm short of a goal at x = 0.68 m, turned 40 deg off it: spins shift objects by up to their
+    size, and one that drifted out there could no longer be pushed back; the turn is made further in."""
+    cube = ap.load_object("cube")
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    goal = ap.Goal(xy=(0.68, 0.0), yaw=math.radians(40.0), resting_state=0, yaw_symmetric=False)
+    T0 = cube.resting_states[0].pose((0.67, 0.0), 0.0)
+    planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    assert not planner.spin_room(0, 0.67, 0.0) and planner.spin_room(0, 0.6, 0.0)
+    plan = planner.plan(T0, goal)
+    spins = [s for s in plan.steps if s.skill == "spin"]
+    assert spins and all(planner.spin_room(0, s.start_pose[0, 3], s.start_pose[1, 3]) for s in spins)
+    assert all(planner.checkers[0].is_free(*cube.planar_pose(s.expected_pose)[1:]) for s in plan.steps)
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=20)
+    assert ex.success, str(ex)
+
+    unbounded = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0, reach=None)
+    spins = [s for s in unbounded.plan(T0, goal).steps if s.skill == "spin"]
+    assert spins and all(s.start_pose[0, 3] > 0.66 for s in spins)  # no arm to reach: turned where it is
+
+
+def test_a_push_with_no_room_for_the_fingertip_is_made_round():
+    """A cube pressed against a block (1.5 cm clear) is pushed away from it by two pushes to either side, not
+    by one whose fingertip would come down on the block."""
+    cube = ap.load_object("cube")
+    block = ap.Box(center=(0.5, 0.085), size=(0.1, 0.04, 0.08))  # spans y 0.065-0.105; the cube's side: 0.05
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    planner = Planner(cube, (block,), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    T0 = cube.resting_states[0].pose((0.5, 0.0), 0.0)
+    assert planner.push_blocked(T0, -math.pi / 2)  # the fingertip would stand in the block
+    assert not planner.push_blocked(T0, math.pi / 2) and not planner.push_blocked(T0, 0.0)
+    assert not Planner(cube, (), predictor=StubPredictor(skills)).push_blocked(T0, -math.pi / 2)
+    plan = planner.plan(T0, ap.Goal(xy=(0.5, -0.15), resting_state=0))
+    first = plan.steps[0]
+    assert first.skill == "push" and abs(math.degrees(wrap_angle(first.params["direction"] + math.pi / 2))) >= 30
+    sim = ap.Simulator(cube, obstacles=(block,), seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    assert execute_plan(plan, sim=sim, max_primitives=20).success
+
+
 def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
     """Pushes towards the goal fail, and so does one side of the detour round them: neither is tried a third time.
 
@@ -243,6 +296,22 @@ def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
     failed = [round(math.degrees(c[1]["direction"])) for c in skills["push"].calls if failing(c[1], c[0])]
     buckets = [round(d / 45.0) for d in failed]  # the planner remembers failures per 45 deg sector
     assert all(buckets.count(b) <= 2 for b in set(buckets)), failed
+
+
+def test_when_every_detour_is_ruled_out_one_that_never_failed_beats_one_that_failed_twice():
+    """A cube 4 cm from a wall (+x): every turn of the detour round a failed push towards +y failed twice too,
+    but the one 5 deg off +x, whose ideal 5 cm would meet the wall. That one is tried (the real push may stop
+    short), not again one that failed twice because it lands free: a cylinder was pushed 36 times so."""
+    cube = ap.load_object("cube")
+    wall = ap.Box(center=(0.6, 0.0), size=(0.02, 0.3, 0.1))
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    planner = Planner(cube, (wall,), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
+    T = cube.resting_states[0].pose((0.5, 0.0), 0.0)
+    for degrees in (90.0, 135.0, 180.0, 45.0):  # failure buckets 2, 3, 4, 1: every turn but 90 - 85 = 5 deg
+        for _ in range(2):
+            planner.record_failure("push", {"direction": math.radians(degrees)}, T)
+    assert not planner.push_blocked(T, math.radians(5.0))
+    assert planner._detour(math.radians(90.0), T) == [pytest.approx(math.radians(5.0))]
 
 
 def test_failure_memory_counts_calls_that_did_not_move_the_object_as_asked():

@@ -42,6 +42,9 @@ KP, KV = 20000.0, 200.0
 IK_DT = 0.02  # seconds: IK at 50 Hz
 FINGERTIP_SITE = "fingertip"
 TIP_RADIUS = 0.008
+# Metres from the base (the world origin) within which :meth:`ArmIK.check_reachable` accepts a fingertip
+# target pointing down: measured 0.814-0.816 m at heights 2-10 cm and headings 0-40 deg, from HOME.
+FINGERTIP_REACH = 0.815
 # The fingers are 13 cm long (the Panda's are 5 cm): a pushing tool, so the hand stays above objects
 # up to 12 cm tall while the fingertip pushes low on them.
 FINGER_LENGTH = 0.132
