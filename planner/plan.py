@@ -20,8 +20,9 @@ twice is not rolled at again (the object is pushed to the nearest other room fir
 fingertip would come down on an obstacle is split the same way from the start.
 
 The arm reaches so far (``reach``, from its base at the world origin): footprints stay where the fingertip
-can get all round them, and spins, which shift objects by up to their own size, happen where such a shift
-still leaves the object within reach (the turn is moved to such a spot when the path's own is not).
+can get all round them, and spins, which shift objects by centimetres (up to their own radius), happen where
+a shift of half that radius still leaves the object within reach (the turn is moved to such a spot when the
+path's own is not).
 """
 
 from __future__ import annotations
@@ -312,8 +313,11 @@ class Planner:
         spot = self._turn_spot(state, start, end)
         if spot is None:
             return [path], out + calls
-        to_spot = self._path(state, start, (*spot, start[2]), deadline)
-        from_spot = self._path(state, (*spot, end[2]), end, deadline)
+        try:
+            to_spot = self._path(state, start, (*spot, start[2]), deadline)
+            from_spot = self._path(state, (*spot, end[2]), end, deadline)
+        except (PlanningError, GoalError):  # no way round by the spot in time: turn where the path does
+            return [path], out + calls
         return [to_spot, from_spot], out + calls_for(to_spot, end[2]) + calls_for(from_spot, final_yaw)
 
     def spin_room(self, state: int, x: float, y: float) -> bool:
