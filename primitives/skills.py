@@ -84,24 +84,30 @@ class Skill:
     def execute(self, sim: Simulator, params=None) -> Outcome:
         """Act and execute; ``Outcome.success``: the criterion for ``params`` was met (and the sample valid).
 
-        With the arm, a contact it cannot reach (:class:`ReachabilityError`, raised before any physics)
-        is masked out together with the points within ``UNREACHABLE_RADIUS`` of it, and the policy's next
-        best contact is tried, up to ``MAX_REACH_RETRIES`` times; then the last error is raised. Without
-        this, a planner asking for the same push again meets the same unreachable contact every time.
+        With the arm, a contact it cannot reach (:class:`ReachabilityError`, raised before any physics) or
+        whose pre-contact point it cannot come down to (:meth:`Simulator.approach_clear`: a wall or a
+        handle above it) is masked out together with the points within ``UNREACHABLE_RADIUS`` of it, and the
+        policy's next best contact is tried, up to ``MAX_REACH_RETRIES`` times; the last try is executed as
+        it is (a blocked descent then fails without touching anything, an unreachable contact raises).
+        Without this, a planner asking for the same push again meets the same contact every time.
         """
         seen = self.observe(sim, params)
         allowed = np.ones(len(seen.points), dtype=bool)
         retries = 0
         while True:
             contact, normal, motion = self._decide(seen, allowed)
+            last_try = retries >= MAX_REACH_RETRIES
             try:
-                out = sim.execute(contact, motion, normal=normal)
-                break
+                if last_try or sim.approach_clear(contact, normal):
+                    out = sim.execute(contact, motion, normal=normal)
+                    break
             except ReachabilityError:
-                allowed &= np.linalg.norm(seen.points - contact, axis=1) > UNREACHABLE_RADIUS
-                retries += 1
-                if retries > MAX_REACH_RETRIES or not allowed.any():
+                if last_try:
                     raise
+            allowed &= np.linalg.norm(seen.points - contact, axis=1) > UNREACHABLE_RADIUS
+            retries += 1
+            if not allowed.any():
+                raise ReachabilityError(f"{self.name}: no contact the arm can reach and come down to")
         out.success = bool(out.valid and rewards.success(self.name, out.pose_before, out.pose_after,
                                                          seen.params, sim.obj))
         return out

@@ -44,3 +44,48 @@ def test_a_skill_gives_up_after_its_retries_with_the_reachability_error(cube):
     with pytest.raises(ReachabilityError):
         load_skill("push").execute(sim, {"direction": 0.0})
     assert len(sim.asked) == skills_module.MAX_REACH_RETRIES + 1
+
+
+class _DescentBlocked(ap.Simulator):
+    """A finger simulator whose pusher cannot come down to the first ``block`` pre-contact points it is asked
+    about (a wall over them, as the arm meets beside obstacles)."""
+
+    def __init__(self, *args, block: int, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.block = block
+        self.checked: list[np.ndarray] = []
+        self.executed: list[np.ndarray] = []
+
+    def approach_clear(self, contact, normal):
+        self.checked.append(np.asarray(contact, dtype=float))
+        return len(self.checked) > self.block
+
+    def execute(self, contact, motion, normal=None):
+        self.executed.append(np.asarray(contact, dtype=float))
+        return super().execute(contact, motion, normal=normal)
+
+
+def test_a_contact_the_pusher_cannot_come_down_to_gives_way_to_the_next_best_one(cube):
+    """Blocked descents are refused before any physics, like unreachable contacts; after the retries, the last
+    choice is executed as it is (its approach then fails without touching anything)."""
+    sim = _DescentBlocked(cube, seed=0, block=2)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    out = load_skill("push").execute(sim, {"direction": 0.0})
+    assert len(sim.checked) == 3 and len(sim.executed) == 1
+    assert np.allclose(sim.executed[0], sim.checked[2]) and out.approach_ok
+    assert min(np.linalg.norm(sim.checked[2] - c) for c in sim.checked[:2]) > skills_module.UNREACHABLE_RADIUS
+
+    sim = _DescentBlocked(cube, seed=0, block=10**6)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    load_skill("push").execute(sim, {"direction": 0.0})
+    assert len(sim.checked) == skills_module.MAX_REACH_RETRIES and len(sim.executed) == 1
+
+
+def test_the_arm_sees_a_wall_over_a_pre_contact_point(cube):
+    wall = ap.Box(center=(0.5, -0.09), size=(0.3, 0.02, 0.1))  # 4 cm from the cube's -y side
+    sim = ap.Simulator(cube, obstacles=(wall,), pusher="arm", seed=0)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    side = np.array([0.5, -0.05, 0.05])
+    assert not sim.approach_clear(side, np.array([0.0, -1.0, 0.0]))  # pre-contact point over the wall
+    assert sim.approach_clear(np.array([0.45, 0.0, 0.05]), np.array([-1.0, 0.0, 0.0]))
+    assert ap.Simulator(cube, obstacles=(wall,), seed=0).approach_clear(side, np.array([0.0, -1.0, 0.0]))

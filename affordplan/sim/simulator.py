@@ -229,6 +229,15 @@ class Simulator:
         return T[:3, :3] @ self._normals_obj[i]
 
     # ------------------------------------------------------------- primitive
+    def approach_clear(self, contact, normal) -> bool:
+        """Whether the pusher can come down to the pre-contact point of ``contact`` (world point, metres) with
+        outward ``normal``, as :meth:`execute` would place it; no physics is run. Always, for the finger."""
+        normal = _vector(normal, "normal")
+        norm = np.linalg.norm(normal)
+        normal = normal / norm if norm > 1e-9 else np.array([0.0, 0.0, 1.0])
+        touch = self._clamp(_vector(contact, "contact") + self._pusher.radius * normal)
+        return bool(self._pusher.can_descend_to(self._clamp(touch + self.protocol.standoff * normal)))
+
     def execute(self, contact, motion, normal=None) -> Outcome:
         """Run one primitive: approach ``contact`` (world point, metres), then move by ``motion``.
 
