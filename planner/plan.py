@@ -124,6 +124,12 @@ def failure_key(obj: ObjectModel, skill: str, params: dict, T_world_object: np.n
     return state, skill, params["target"]
 
 
+def _disc(radius: float, n: int) -> np.ndarray:
+    """A regular ``n``-gon of circumradius ``radius`` metres about the origin, (n, 2)."""
+    a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    return radius * np.stack([np.cos(a), np.sin(a)], axis=1)
+
+
 def inflated_footprints(obj: ObjectModel, clearance: float) -> dict[int, np.ndarray]:
     """Each resting state's footprint grown by ``clearance`` metres (room for the fingertip)."""
     return {s.index: inflate(footprint(obj, s.index), clearance) for s in obj.resting_states}
@@ -173,9 +179,7 @@ class Planner:
         self.reach = reach
         self.footprints = inflated_footprints(obj, clearance)
         self._shadows = {s.index: footprint(obj, s.index) for s in obj.resting_states}  # not inflated
-        finger = FINGER_ROOM * np.stack([np.cos(np.linspace(0, 2 * np.pi, 8, endpoint=False)),
-                                         np.sin(np.linspace(0, 2 * np.pi, 8, endpoint=False))], axis=1)
-        self._finger = FootprintChecker(finger, self.obstacles, Workspace((-2.0, 2.0), (-2.0, 2.0)))
+        self._finger = FootprintChecker(_disc(FINGER_ROOM, 8), self.obstacles, Workspace((-2.0, 2.0), (-2.0, 2.0)))
         self._standoff = Protocol().standoff
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace, reach)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
@@ -480,8 +484,11 @@ class Planner:
         if pushes:
             return pushes
         turns = [float(wrap_angle(direction + sign * t)) for t in DETOUR_ANGLES for sign in (1.0, -1.0)]
-        return [min(turns, key=lambda d: (self.push_blocked(T, d), self._avoided("push", {"direction": d}, T),
-                                          not lands_free(d), self._failed("push", {"direction": d}, T)))]
+        def rank(d: float) -> tuple:  # blocked, failed twice, landing in the way, failures: what _avoided weighs
+            failed = self._failed("push", {"direction": d}, T)
+            return self.push_blocked(T, d), failed >= FAILURES_TO_AVOID, not lands_free(d), failed
+
+        return [min(turns, key=rank)]
 
     def _path(self, state: int, start, goal, deadline: float) -> np.ndarray:
         left = deadline - time.perf_counter()
@@ -520,9 +527,8 @@ class Planner:
         """Where to push an object that is not free at ``cur`` (x, y, yaw), at its yaw: of the free positions
         (5 mm rings) at most ``FREE_SEARCH_SLACK`` farther than the nearest, one the push to which is not avoided
         (:meth:`_avoided`: no room for the fingertip, or failed twice), and of those the one nearest ``toward``
-        (x, y: where the segment goes). A die
-        pressed against a block, its goal along the block, was pushed off it on the side nearest by a hair,
-        away from the goal and out of the arm's reach."""
+        (x, y: where the segment goes). A die pressed against a block, its goal along the block, was pushed off
+        it on the side nearest by a hair, away from the goal and out of the arm's reach."""
         T = state_pose(self.obj, state, *cur)
         found: list[tuple[bool, float, float, float]] = []  # (avoided, distance to toward, x, y)
         first = None
@@ -548,8 +554,7 @@ class Planner:
         the disc may reach over the edge while the object's own footprint stays inside.
         """
         r = max(self.radius[a], self.radius[b]) + self.roll_margin
-        disc = r * np.stack([np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
-                             np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False))], axis=1)
+        disc = _disc(r, 16)
         ws = self.workspace
         grown = Workspace(x=(ws.x[0] - r, ws.x[1] + r), y=(ws.y[0] - r, ws.y[1] + r))
         for room in (FootprintChecker(disc, self.obstacles, ws), FootprintChecker(disc, self.obstacles, grown)):

@@ -229,14 +229,21 @@ class Simulator:
         return T[:3, :3] @ self._normals_obj[i]
 
     # ------------------------------------------------------------- primitive
-    def approach_clear(self, contact, normal) -> bool:
-        """Whether the pusher can come down to the pre-contact point of ``contact`` (world point, metres) with
-        outward ``normal``, as :meth:`execute` would place it; no physics is run. Always, for the finger."""
-        normal = _vector(normal, "normal")
+    def _approach_points(self, contact: np.ndarray, normal) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(unit normal, touch, pre-contact point) of a primitive at ``contact`` (world, metres): the fingertip's
+        centre touching the surface, and ``protocol.standoff`` further out along the normal (both kept above
+        the table). ``normal``: the outward surface normal; by default that of the nearest surface sample."""
+        normal = self.surface_normal(contact) if normal is None else _vector(normal, "normal")
         norm = np.linalg.norm(normal)
         normal = normal / norm if norm > 1e-9 else np.array([0.0, 0.0, 1.0])
-        touch = self._clamp(_vector(contact, "contact") + self._pusher.radius * normal)
-        return bool(self._pusher.can_descend_to(self._clamp(touch + self.protocol.standoff * normal)))
+        touch = self._clamp(contact + self._pusher.radius * normal)
+        return normal, touch, self._clamp(touch + self.protocol.standoff * normal)
+
+    def approach_clear(self, contact, normal=None) -> bool:
+        """Whether the pusher can come down to the pre-contact point of ``contact`` (world point, metres) with
+        outward ``normal``, as :meth:`execute` would place it; no physics is run. Always, for the finger."""
+        _, _, pre = self._approach_points(_vector(contact, "contact"), normal)
+        return bool(self._pusher.can_descend_to(pre))
 
     def execute(self, contact, motion, normal=None) -> Outcome:
         """Run one primitive: approach ``contact`` (world point, metres), then move by ``motion``.
@@ -247,15 +254,10 @@ class Simulator:
         """
         contact = _vector(contact, "contact")
         motion = np.clip(_vector(motion, "motion"), -1.0, 1.0)
-        normal = self.surface_normal(contact) if normal is None else _vector(normal, "normal")
-        norm = np.linalg.norm(normal)
-        normal = normal / norm if norm > 1e-9 else np.array([0.0, 0.0, 1.0])
+        normal, touch, pre = self._approach_points(contact, normal)
         p = self.protocol
         steps0 = self.physics_steps
         pose_before = self.object_pose()
-        radius = self._pusher.radius
-        touch = self._clamp(contact + radius * normal)
-        pre = self._clamp(touch + p.standoff * normal)
         if self._ik is not None:
             self._ik.check_reachable([pre, touch], self._pusher.q)
         result = dict(approach_ok=False, valid=True, invalid_reason=None)
