@@ -125,6 +125,14 @@ def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench_query(args: argparse.Namespace) -> int:
+    from primitives.querybench import bench_queries, report
+
+    rows = bench_queries(tuple(args.skill), repeats=args.repeats, batch=args.batch, seed=args.seed)
+    print(json.dumps([r.as_dict() for r in rows], indent=2) if args.json else report(rows))
+    return 0
+
+
 def _cmd_bench_plan(args: argparse.Namespace) -> int:
     from planner.bench import bench_plan
 
@@ -310,6 +318,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="examples:\n"
                "  affordplan bench sim --object cube mug -n 500\n"
                "  affordplan bench sim2sim -n 100\n"
+               "  affordplan bench query\n"
                "  affordplan bench plan --tasks 50 --sim arm",
         formatter_class=_formatter,
     )
@@ -345,6 +354,22 @@ def build_parser() -> argparse.ArgumentParser:
     s2s.add_argument("--skill", nargs="+", choices=["push", "roll", "spin"],
                      help="compare the shipped skills' success instead (on held-out objects; -n draws each)")
     s2s.set_defaults(func=_cmd_bench_sim2sim)
+
+    bq = bench_sub.add_parser(
+        "query", help="time the skills' success queries",
+        description=_wrap("Median time of one P(success) query per skill, alone and in a batch as the planner "
+                          "asks them, with the searched success model and with the frame search's own rating, on "
+                          "1 and 2 torch threads."),
+        epilog="examples:\n  affordplan bench query\n  affordplan bench query --skill spin --repeats 300 --json",
+        formatter_class=_formatter,
+    )
+    bq.add_argument("--skill", nargs="+", default=["push", "spin", "roll"], choices=["push", "spin", "roll"],
+                    help="skills to time (default: all three)")
+    bq.add_argument("--repeats", type=_positive_int, default=100, help="timed queries each (default: %(default)s)")
+    bq.add_argument("--batch", type=_positive_int, default=32, help="queries per batch (default: %(default)s)")
+    bq.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    bq.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bq.set_defaults(func=_cmd_bench_query)
 
     bp = bench_sub.add_parser(
         "plan", help="plan-and-execute success on random tasks, affordplan vs greedy",

@@ -193,31 +193,40 @@ def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train",
 @torch.no_grad()
 def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split: str = "train",
                          n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
-                         progress: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                         progress: bool = True) -> tuple[np.ndarray, Rollouts]:
     """``n`` valid greedy rollouts acting in the frame of ``search`` (:class:`primitives.frames.FrameSearch`)
-    that ``model`` rates likeliest: ``(best raw rating, success, parameterised)``, each ``(n,)``."""
+    that ``model`` rates likeliest.
+
+    Returns the chosen frames' raw ratings ``(n,)`` and the rollouts as seen *in the goal frame* (observation and
+    the policy's decision there) with the frame-searched outcome: the data of a searched success model, which
+    rates the searched skill from the goal frame alone (:func:`fit`).
+    """
     from primitives.evaluate import greedy_action
     from primitives.frames import select_frame
 
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
-    rating, succ, par = [], [], []
+    rating, obs_l, dec_l, succ, group, par = [], [], [], [], [], []
     bar = tqdm(total=n, desc=f"frame-search rollouts {skill} ({split})", disable=not progress, unit="rollout",
                mininterval=2.0)
     while len(succ) < n:
-        env.reset()
+        obs = env.reset()
         env.seen, p = select_frame(env.seen, model.predict, search.frames(skill, env.seen.params))
         idx, motion, _ = greedy_action(model.policy, env.seen.obs)
         res = env.step(idx, motion)
         if not res.valid:
             continue
         rating.append(p)
+        obs_l.append(obs.astype(np.float16))
+        dec_l.append(decision_features(model.policy, torch.from_numpy(obs)[None])[2][0].numpy())
         succ.append(res.success)
+        group.append(zlib.crc32(repr(env.object_key).encode()))
         par.append(res.params is not None)
         bar.update(1)
     bar.close()
     env.close()
-    return np.array(rating), np.array(succ), np.array(par)
+    return np.array(rating), Rollouts(np.stack(obs_l), np.stack(dec_l).astype(np.float32), np.array(succ),
+                                      np.array(group), np.array(par))
 
 
 def fit_frame_calibration(rating: np.ndarray, success: np.ndarray) -> tuple[float, float]:
@@ -410,7 +419,17 @@ def build_parser() -> argparse.ArgumentParser:
     sub.choices["evaluate"].add_argument("--model", default=None, help="success model (default: shipped)")
     sub.choices["evaluate"].add_argument("--frames", default=None, metavar="shipped|PATH",
                                          help="judge the skill acting with this frame search (frames.json, or the "
-                                              "shipped one) and its calibrated ratings")
+                                              "shipped one): its calibrated ratings, and the searched success "
+                                              "model's beside them")
+    sub.choices["evaluate"].add_argument("--searched", default=None, metavar="PATH",
+                                         help="with --frames: the searched success model to judge (default: the "
+                                              "shipped one, if any)")
+    sub.choices["train"].add_argument("--frames", default=None, metavar="shipped|PATH",
+                                      help="train a searched success model: the skill acts with this frame search "
+                                           "(frames.json, or the shipped one), the model rates it from the goal "
+                                           "frame")
+    sub.choices["train"].add_argument("--model", default=None,
+                                      help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
     sub.choices["train"].add_argument("--epochs", type=int, default=40)
     sub.choices["train"].add_argument("--members", type=int, default=1,
@@ -442,12 +461,24 @@ def _run(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     policy = load_policy(args.policy, args.skill)
     if args.command == "train":
-        cache = out / f"train_rollouts_{args.rollouts}_{args.seed}.npz"
-        data = Rollouts.load(cache) if cache.exists() else collect(policy, args.skill, args.rollouts, "train",
-                                                                   seed=args.seed, progress=not args.json)
+        searched = args.frames is not None
+        cache = out / f"train_{'searched_' if searched else ''}rollouts_{args.rollouts}_{args.seed}.npz"
+        if cache.exists():
+            data = Rollouts.load(cache)
+        elif searched:
+            rater = SuccessModel(policy, load_success_net(args.skill, args.model))
+            data = collect_frame_search(rater, args.skill, args.rollouts, _load_frame_search(args.skill, args.frames),
+                                        "train", seed=args.seed, progress=not args.json)[1]
+        else:
+            data = collect(policy, args.skill, args.rollouts, "train", seed=args.seed, progress=not args.json)
         data.save(cache)
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json)
         info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped")
+        if searched:
+            info.update(frames=args.frames, model=args.model or "shipped")
+        info["command"] = ("python -m primitives.success train " + args.skill + f" --rollouts {args.rollouts} "
+                           f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
+                           + (f" --frames {args.frames}" if searched else ""))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
         return 0
@@ -477,8 +508,9 @@ def _run_frames(args: argparse.Namespace) -> int:
     search = FrameSearch(args.turns, args.mirror)
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
-    rating, success, par = collect_frame_search(model, args.skill, args.rollouts, search, "train", seed=args.seed,
-                                                progress=not args.json)
+    rating, data = collect_frame_search(model, args.skill, args.rollouts, search, "train", seed=args.seed,
+                                        progress=not args.json)
+    success, par = data.success, data.parameterised
     platt = fit_frame_calibration(rating[par], success[par])
     platt_seed = fit_frame_calibration(rating[~par], success[~par]) if (~par).sum() >= 50 else (1.0, 0.0)
     search = FrameSearch(search.turns, search.mirror, platt, platt_seed)
@@ -496,22 +528,48 @@ def _run_frames(args: argparse.Namespace) -> int:
     return 0
 
 
-def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
-    """``evaluate --frames``: the skill acting with a frame search on unseen objects, and its calibrated ratings."""
+def _load_frame_search(skill: str, frames: str):
     from primitives.frames import FrameSearch
     from primitives.skills import shipped_frame_search
 
-    search = shipped_frame_search(args.skill) if args.frames == "shipped" else FrameSearch.load(args.frames)
+    search = shipped_frame_search(skill) if frames == "shipped" else FrameSearch.load(frames)
     if search is None:
-        raise InputError(f"no frame search is shipped for {args.skill}")
-    rating, success, par = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
-                                                seed=args.seed, progress=not args.json)
+        raise InputError(f"no frame search is shipped for {skill}")
+    return search
+
+
+def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
+    """``evaluate --frames``: the skill acting with a frame search on unseen objects, judged by two raters on the
+    same rollouts: the calibrated rating of the chosen frame, and the searched success model, which rates the
+    searched skill from the goal frame alone (the shipped ``{skill}_success_searched.pt``, or ``--searched``)."""
+    from primitives.frames import reframe_obs
+
+    search = _load_frame_search(args.skill, args.frames)
+    rating, data = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
+                                        seed=args.seed, progress=not args.json)
+    success, par = data.success, data.parameterised
     p = search.calibrate(rating, par)
+    obs = data.obs[0].astype(np.float32)
+    frames = search.frames(args.skill, {})
     result = dict(skill=args.skill, objects="test split (never trained on)", frames=args.frames,
                   all=metrics(p, success), parameterised=metrics(p[par], success[par]),
-                  seed_objective=metrics(p[~par], success[~par]) if (~par).any() else None)
+                  seed_objective=metrics(p[~par], success[~par]) if (~par).any() else None,
+                  query_ms=1e3 * bench_query(model, reframe_obs(obs, frames)),
+                  frames_per_query=len(frames))
+    searched_path = Path(args.searched) if args.searched else WEIGHTS_DIR / f"{args.skill}_success_searched.pt"
+    if args.searched or searched_path.exists():
+        searched = SuccessModel(model.policy, load_success_net(args.skill, searched_path))
+        with torch.no_grad():
+            q = searched.net(torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)).numpy()
+        result["searched_model"] = dict(path=str(searched_path.name), all=metrics(q, success),
+                                        parameterised=metrics(q[par], success[par]),
+                                        query_ms=1e3 * bench_query(searched, obs))
     if args.plot:
         plot_reliability(p, success, args.plot, f"{args.skill} success model, frame search, unseen objects")
+        if "searched_model" in result:
+            path = Path(args.plot)
+            plot_reliability(q, success, path.with_name(path.stem + "_searched" + path.suffix),
+                             f"{args.skill} searched success model, unseen objects")
     print(json.dumps(result, indent=2))
     return 0
 

@@ -118,7 +118,7 @@ def test_scene_files_on_disk(tmp_path):
 
 # ------------------------------------------------------------------------------------ help
 SUBCOMMANDS = [["demo"], ["plan"], ["render"], ["affordances"], ["bench"], ["bench", "sim"],
-               ["bench", "sim2sim"], ["bench", "plan"]]
+               ["bench", "sim2sim"], ["bench", "query"], ["bench", "plan"]]
 
 
 def test_cli_help_has_examples(capsys):
@@ -286,6 +286,19 @@ def test_cli_bench_json(capsys):
     data = json.loads(capsys.readouterr().out)
     assert data[0]["object"] == "cube" and data[0]["primitives"] == 3
     assert data[0]["primitives_per_s"] > 0
+
+
+def test_bench_query_times_each_rater_of_each_skill(capsys):
+    import torch
+
+    before = torch.get_num_threads()
+    assert cli.main(["bench", "query", "--skill", "spin", "roll", "--repeats", "2", "--batch", "3", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    raters = {(r["skill"], r["rater"]) for r in rows}
+    assert raters == {("spin", "searched model"), ("spin", "frame search (12 frames)"),
+                      ("roll", "searched model"), ("roll", "frame search (2 frames)")}
+    assert {r["threads"] for r in rows} == {1, 2} and all(r["single_ms"] > 0 and r["batch"] == 3 for r in rows)
+    assert torch.get_num_threads() == before  # the thread count is put back
 
 
 def test_bench_sim2sim_compares_identical_primitives():

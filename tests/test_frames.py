@@ -131,3 +131,53 @@ def test_given_weights_get_no_shipped_frame_search(tmp_path):
     assert load_skill("spin", weights=tmp_path / "w.pt").frame_search is None  # the shipped calibration is not theirs
     search = FrameSearch(4, False)
     assert load_skill("spin", weights=tmp_path / "w.pt", frame_search=search).frame_search == search
+
+
+def test_a_searched_success_model_rates_the_searched_skill_from_the_goal_frame(tmp_path):
+    import torch
+    from scipy.special import expit
+
+    from primitives import load_skill, success
+    from primitives.skills import Skill, shipped_frame_search
+
+    net = success.SuccessNet()
+    with torch.no_grad():  # every member answers logit 0, the Platt scaling turns it into sigmoid(2)
+        for member in net.members:
+            member.head[-1].weight.zero_()
+            member.head[-1].bias.zero_()
+        net.platt.copy_(torch.tensor([1.0, 2.0]))
+    success.save(net, tmp_path / "searched.pt", {})
+    shipped = load_skill("spin", searched=False)
+    skill = Skill("spin", shipped.model, frame_search=shipped_frame_search("spin"),
+                  searched_weights=tmp_path / "searched.pt")
+    obj = ap.load_object("lunch_box")
+
+    def fresh():
+        sim = ap.Simulator(obj, seed=2)
+        sim.reset()
+        return sim
+
+    params = {"angle": math.radians(30)}
+    assert skill.success_probability(fresh(), params) == pytest.approx(expit(2.0), abs=1e-6)
+    assert shipped.success_probability(fresh(), params) != pytest.approx(expit(2.0), abs=1e-3)
+    obs = skill_observation(fresh(), "spin", params, 256).obs
+    assert np.allclose(skill.success_probability_obs(np.stack([obs, obs])), expit(2.0), atol=1e-6)
+    # it only rates: the skill still acts in the frame the search picks
+    assert np.allclose(skill.observe(fresh(), params).A_frame_world, shipped.observe(fresh(), params).A_frame_world)
+    assert Skill("spin", shipped.model, searched_weights=tmp_path / "searched.pt").searched_model is None
+
+
+@pytest.mark.parametrize("name", ["push", "roll", "spin"])
+def test_the_shipped_skills_rate_with_their_shipped_searched_success_model(name):
+    import torch
+
+    from primitives import load_skill
+    from primitives.success import WEIGHTS_DIR, load_success_net
+
+    skill = load_skill(name)
+    assert skill.searched_model is not None
+    info = torch.load(WEIGHTS_DIR / f"{name}_success_searched.pt", weights_only=False)["info"]
+    assert info["frames"] == "shipped" and f"train {name}" in info["command"]
+    assert load_success_net(name, WEIGHTS_DIR / f"{name}_success_searched.pt").members
+    assert load_skill(name, searched=False).searched_model is None
+    assert load_skill(name, frame_search=False).searched_model is None

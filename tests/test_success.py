@@ -105,3 +105,21 @@ def test_shipped_success_models_load_and_answer():
     for name, params in (("push", {"direction": 0.0}), ("spin", {"angle": 0.5}), ("roll", {"target": 1})):
         p = load_skill(name).success_probability(sim, params)
         assert 0.0 < p < 1.0
+
+
+def test_frame_searched_rollouts_keep_the_goal_frame_view():
+    """What a searched success model learns from: the goal-frame observation and decision the skill started from,
+    and the outcome of acting in the frame the search picked from it."""
+    from primitives.frames import FrameSearch, reframe_obs
+    from primitives.skills import load_skill
+
+    model = load_skill("spin", frame_search=False).success_model
+    search = FrameSearch(4, False)
+    rating, data = success.collect_frame_search(model, "spin", 3, search, "train", n_objects=3, seed=1,
+                                                p_params=1.0, progress=False)
+    assert rating.shape == (3,) and len(data) == 3 and data.parameterised.all()
+    obs = torch.from_numpy(data.obs.astype(np.float32))
+    _, _, decision = success.decision_features(model.policy, obs)
+    assert torch.allclose(decision, torch.from_numpy(data.decision), atol=0.05)  # fp16-stored clouds
+    best = [model.predict(reframe_obs(o, search.frames("spin", {}))).max() for o in data.obs.astype(np.float32)]
+    assert np.allclose(best, rating, atol=0.02)
