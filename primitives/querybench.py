@@ -15,7 +15,6 @@ scaled), on 1 and 2 torch threads. Medians of ``repeats`` runs; the cloud is the
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,8 +23,10 @@ import torch
 from affordplan.errors import InputError
 from primitives import params as skill_params
 from primitives.env import PRIMITIVES, skill_observation
+from primitives.success import bench_query
 
 TARGET_MS = 5.0  # issue target: one query under 5 ms on 2 cores
+WARM_UP = 10  # untimed calls before each timing
 
 
 @dataclass
@@ -39,17 +40,6 @@ class QueryTiming:
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
-
-
-def _median_seconds(skill, obs: np.ndarray, repeats: int) -> float:
-    """Median seconds of ``skill.success_probability_obs(obs)`` (one warm-up call first: lazy loading)."""
-    skill.success_probability_obs(obs)
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        skill.success_probability_obs(obs)
-        times.append(time.perf_counter() - t)
-    return float(np.median(times))
 
 
 def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batch: int = 32,
@@ -79,8 +69,8 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
                          else f"frame search ({len(skill.frames(params))} frames)")
                 for n in threads:
                     torch.set_num_threads(n)
-                    single = _median_seconds(skill, obs[None], repeats)
-                    batched = _median_seconds(skill, many, max(3, repeats // 10)) / batch
+                    single = bench_query(skill.success_probability_obs, obs[None], repeats, WARM_UP)
+                    batched = bench_query(skill.success_probability_obs, many, max(3, repeats // 10), WARM_UP) / batch
                     rows.append(QueryTiming(name, rater, n, 1e3 * single, 1e3 * batched, batch))
     finally:
         torch.set_num_threads(before)

@@ -123,3 +123,12 @@ def test_frame_searched_rollouts_keep_the_goal_frame_view():
     assert torch.allclose(decision, torch.from_numpy(data.decision), atol=0.05)  # fp16-stored clouds
     best = [model.predict(reframe_obs(o, search.frames("spin", {}))).max() for o in data.obs.astype(np.float32)]
     assert np.allclose(best, rating, atol=0.02)
+    # the same rollouts in every frame the search tries: the decision there, the outcome unchanged
+    views = success.FrameViews.of(data, model.policy, "spin", search, progress=False)
+    assert views.frames.shape == (3, 4, 3, 3) and np.all(views.count == 4)
+    assert np.allclose(views.decision[:, 0], data.decision, atol=0.05)  # fp16-stored clouds, as above
+    seen = torch.from_numpy(reframe_obs(data.obs[1].astype(np.float32), search.frames("spin", {}))[2:3])
+    assert np.allclose(views.decision[1, 2], success.decision_features(model.policy, seen)[2][0].numpy(), atol=1e-5)
+    data.group[:] = [1, 2, 3]  # one rollout per object: two to train on, one to calibrate
+    net, info = success.fit(data, epochs=1, views=views, calib_fraction=0.34, progress=False)
+    assert info["frame_views"] and (info["train"], info["calibration"]) == (2, 1)
