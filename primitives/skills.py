@@ -172,21 +172,21 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
     ``frame_search`` (:mod:`primitives.frames`): ``True``, the one shipped beside the weights where there is one
     and both the policy and the success model are the shipped ones (its calibration is theirs), else none;
     ``False``, act in the goal frame, as trained; or a :class:`~primitives.frames.FrameSearch`.
-    ``searched``: with the shipped frame search, rate requests with the searched success model shipped beside it
-    (``weights/{name}_success_searched.pt``) where there is one; ``False``: rate them through the frame search.
+    ``searched``: with the shipped weights and frame search (``frame_search=True``), rate requests with the
+    searched success model shipped beside them (``weights/{name}_success_searched.pt``) where there is one;
+    ``False``: rate them through the frame search.
     """
     if name not in PRIMITIVES:
         raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
+    shipped = frame_search is True and weights is None and success_weights is None
     if frame_search is True:
-        frame_search = shipped_frame_search(name) if weights is None and success_weights is None else None
+        frame_search = shipped_frame_search(name) if shipped else None
     elif frame_search is False:
         frame_search = None
     elif not isinstance(frame_search, FrameSearch):
         raise InputError(f"frame_search must be True, False or a FrameSearch, got {frame_search!r}")
-    searched_path = WEIGHTS_DIR / f"{name}_success_searched.pt"
-    shipped = weights is None and success_weights is None and frame_search is not None
-    searched_weights = (searched_path if searched and shipped and searched_path.exists()
-                        and frame_search == shipped_frame_search(name) else None)
+    searched_path = WEIGHTS_DIR / f"{name}_success_searched.pt"  # trained on the shipped skill's outcomes
+    searched_weights = searched_path if searched and shipped and searched_path.exists() else None
     return Skill(name, load_policy(weights, name), success_weights=success_weights, frame_search=frame_search,
                  searched_weights=searched_weights)
