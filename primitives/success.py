@@ -525,18 +525,18 @@ def _run(args: argparse.Namespace) -> int:
     policy = load_policy(args.policy, args.skill)
     if args.command == "train":
         searched = args.frames is not None
+        search = _load_frame_search(args.skill, args.frames) if searched else None
         cache = out / f"train_{'searched_' if searched else ''}rollouts_{args.rollouts}_{args.seed}.npz"
         if cache.exists():
             data = Rollouts.load(cache)
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model))
-            data = collect_frame_search(rater, args.skill, args.rollouts, _load_frame_search(args.skill, args.frames),
-                                        "train", seed=args.seed, progress=not args.json)[1]
+            data = collect_frame_search(rater, args.skill, args.rollouts, search, "train", seed=args.seed,
+                                        progress=not args.json)[1]
         else:
             data = collect(policy, args.skill, args.rollouts, "train", seed=args.seed, progress=not args.json)
         data.save(cache)
-        views = (FrameViews.of(data, policy, args.skill, _load_frame_search(args.skill, args.frames),
-                               progress=not args.json) if searched and args.views else None)
+        views = FrameViews.of(data, policy, args.skill, search, progress=not args.json) if args.views else None
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
                         views=views)
         info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped")
