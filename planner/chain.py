@@ -23,7 +23,8 @@ from affordplan.geometry import wrap_angle
 from primitives.params import PUSH_STEP, SPIN_MAX, SPIN_MIN
 
 YAW_DEADBAND = math.radians(10.0)  # smaller yaw errors are left alone (goal tolerance: 15 deg)
-MIN_PUSH = 0.015  # metres: shorter strides are not pushed (goal tolerance: 3 cm)
+MIN_PUSH = 0.015  # metres: shorter strides are not pushed (goal tolerance: 3 cm) ...
+MIN_STRIDE = 0.001  # ... unless the path has nothing else to do (a goal asked to within less); none below this
 SPIN_SLACK = math.radians(5.0)  # a rated split of a turn may sum to this much more or less (spins_for)
 
 
@@ -106,7 +107,7 @@ def path_to_calls(path: np.ndarray, goal_yaw: float | None = None,
             yaw = wrap_angle(yaw + a)
             calls.append(("spin", {"angle": a}, (x, y, yaw)))
         stride = math.hypot(tx - x, ty - y)
-        if stride >= MIN_PUSH or (j == last and stride > 0.0 and not calls):
+        if stride >= MIN_PUSH or (j == last and stride > MIN_STRIDE and not calls):
             v = v_pushes(x, y, tx, ty, yaw, is_free) if j == last and stride < PUSH_STEP - 1e-9 else None
             calls += v or [("push", {"direction": math.atan2(ty - y, tx - x)}, (tx, ty, yaw))]
             x, y = tx, ty

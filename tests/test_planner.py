@@ -181,6 +181,10 @@ def test_a_short_last_stride_is_two_full_pushes_in_a_v():
     long = chain.path_to_calls(np.array([[0.6, 0.0, 0.0], [0.65, 0.0, 0.0], [0.67, 0.0, 0.0]]))  # 5 cm, then 2 cm
     assert len(long) == 3 and long[0][1]["direction"] == 0.0 and np.allclose(long[0][2][:2], (0.65, 0.0))
     assert np.allclose(long[-1][2][:2], (0.67, 0.0))  # the last 2 cm as a V
+    # a lone stride under MIN_PUSH is still pushed (a goal asked to within less), one of floating-point dust is not
+    lone = chain.path_to_calls(np.array([[0.6, 0.0, 0.0], [0.61, 0.0, 0.0]]))
+    assert [c[0] for c in lone] == ["push", "push"] and np.allclose(lone[-1][2][:2], (0.61, 0.0))
+    assert chain.path_to_calls(np.array([[0.6, 0.0, 0.0], [0.6 + 1e-12, 0.0, 0.0]])) == []
 
 
 def test_forced_failure_replans_without_repeating_the_failed_step():
@@ -525,6 +529,20 @@ def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
     assert obj.name.startswith(f"test_{OBJECTS_PER_SEED * 3 + 7}_")
     with pytest.raises(InputError, match="n_tasks"):
         bench_plan(OBJECTS_PER_SEED + 1, seed=0, progress=False)
+
+
+def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
+    from planner.bench import RARE_GOAL_STATE, BenchReport, TaskResult
+
+    def result(ok, p_goal):
+        return TaskResult("affordplan", "open", ok, 0.1, 5, 1, "", p_goal)
+
+    report = BenchReport([result(True, 0.4), result(True, 0.3), result(False, 0.02), result(True, 0.01),
+                          result(False, RARE_GOAL_STATE)])
+    s = report.summary("affordplan")
+    assert s["success"] == pytest.approx(3 / 5)  # rare goals stay in the success rate
+    assert s["rare_goal_states"] == dict(tasks=2, success=0.5)
+    assert "rare goal 1/2" in report.report()
 
 
 def test_a_primitive_refused_before_any_physics_ends_the_execution():
