@@ -56,6 +56,11 @@ def versions() -> dict[str, str]:
     return out
 
 
+def versions_text(skip: tuple[str, ...] = ()) -> str:
+    """:func:`versions` as one line, ``"affordplan 0.10.0, mujoco 4.0.0, ..."``, less the names in ``skip``."""
+    return ", ".join(f"{name} {v}" for name, v in versions().items() if name not in skip)
+
+
 __all__ = [
     "Box",
     "Goal",
@@ -70,4 +75,5 @@ __all__ = [
     "plan",
     "random_object",
     "versions",
+    "versions_text",
 ]

@@ -222,10 +222,9 @@ class _VersionAction(argparse.Action):
         super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from affordplan import versions
+        from affordplan import __version__, versions_text
 
-        v = versions()
-        print(f"affordplan {v.pop('affordplan')} (" + ", ".join(f"{k} {x}" for k, x in v.items()) + ")")
+        print(f"affordplan {__version__} ({versions_text(skip=('affordplan',))})")
         parser.exit()
 
 

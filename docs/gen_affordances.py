@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from affordplan import versions
+from affordplan import versions_text
 from affordplan.objects.model import load_object
 from primitives.affordances import affordance_table, format_table, plot_table
 
@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
         stats.append((name, *agreement(rows)))
         tables.append(f"## {name}\n\n```\n{format_table(obj, rows)}\n```\n\n"
                       f"![{name}](images/affordances_{name}.png)\n")
-    v = ", ".join(f"{k} {x}" for k, x in versions().items())
+    v = versions_text()
     lines = [
         "# Affordance tables for the seed's seven objects",
         "",

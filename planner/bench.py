@@ -21,7 +21,7 @@ import networkx as nx
 import numpy as np
 from tqdm import tqdm
 
-from affordplan import versions
+from affordplan import versions, versions_text
 from affordplan.errors import AffordplanError, InputError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel, random_object
@@ -76,7 +76,7 @@ class BenchReport:
                                           success=float(np.mean([r.success for r in rare])) if rare else None))
 
     def report(self) -> str:
-        lines = ["versions: " + ", ".join(f"{k} {v}" for k, v in versions().items()),
+        lines = ["versions: " + versions_text(),
                  f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median)':>19s} "
                  f"{'primitives/task':>16s} {'replans/task':>13s}  by scene; goal state rarer than "
                  f"{RARE_GOAL_STATE:.0%} of drops"]
