@@ -130,6 +130,20 @@ def _disc(radius: float, n: int) -> np.ndarray:
     return radius * np.stack([np.cos(a), np.sin(a)], axis=1)
 
 
+def _grid_argmin(workspace: Workspace, cost: Callable[[float, float], float], ok: Callable[[float, float], bool],
+                 step: float = 0.01) -> tuple[float, float] | None:
+    """The point of a ``step`` (metres) grid over ``workspace`` with the lowest ``cost`` among those where ``ok``
+    holds (the first on a tie, x then y ascending; ``ok``, the costly test, only where the cost would win);
+    ``None`` where it holds nowhere."""
+    best, best_cost = None, math.inf
+    for px in np.arange(workspace.x[0], workspace.x[1] + 1e-9, step):
+        for py in np.arange(workspace.y[0], workspace.y[1] + 1e-9, step):
+            c = cost(float(px), float(py))
+            if c < best_cost and ok(float(px), float(py)):
+                best, best_cost = (float(px), float(py)), c
+    return best
+
+
 def inflated_footprints(obj: ObjectModel, clearance: float) -> dict[int, np.ndarray]:
     """Each resting state's footprint grown by ``clearance`` metres (room for the fingertip)."""
     return {s.index: inflate(footprint(obj, s.index), clearance) for s in obj.resting_states}
@@ -347,17 +361,10 @@ class Planner:
         def room(px: float, py: float) -> bool:
             return self.spin_room(state, px, py) and all(checker.is_free(px, py, a) for a in yaws)
 
-        ws = self.workspace
         if room(start[0], start[1]):
             return float(start[0]), float(start[1])
-        best, best_cost = None, math.inf
-        for px in np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01):
-            for py in np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01):
-                cost = (math.hypot(px - end[0], py - end[1]) + math.hypot(px - start[0], py - start[1])
-                        + TURN_SPOT_MOVE_COST)
-                if cost < best_cost and room(px, py):
-                    best, best_cost = (float(px), float(py)), cost
-        return best
+        return _grid_argmin(self.workspace, lambda px, py: math.hypot(px - end[0], py - end[1])
+                            + math.hypot(px - start[0], py - start[1]) + TURN_SPOT_MOVE_COST, room)
 
     def _steps(self, state: int, start: tuple[float, float, float], calls) -> list[Step]:
         steps: list[Step] = []
@@ -573,15 +580,11 @@ class Planner:
         object and then the goal."""
         if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self._spoiled(*cur[:2]):
             return float(cur[0]), float(cur[1])
-        ws = self.workspace
-        best, best_cost = None, math.inf
-        for px in np.arange(ws.x[0], ws.x[1] + 1e-9, 0.01):
-            for py in np.arange(ws.y[0], ws.y[1] + 1e-9, 0.01):
-                cost = math.hypot(px - cur[0], py - cur[1]) + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1])
-                if cost < best_cost and room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2]) \
-                        and not self._spoiled(px, py):
-                    best, best_cost = (float(px), float(py)), cost
-        return best
+        return _grid_argmin(self.workspace,
+                            lambda px, py: math.hypot(px - cur[0], py - cur[1])
+                            + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1]),
+                            lambda px, py: room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2])
+                            and not self._spoiled(px, py))
 
 
 @dataclass
