@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import Counter
 from dataclasses import asdict, dataclass, field
 
 import networkx as nx
@@ -56,6 +57,12 @@ class TaskResult:
     replans: int
     reason: str = ""
     goal_state_probability: float = 1.0  # share of random drops that come to rest in the goal's state
+    # where the object ended: metres from the goal, radians off its yaw (0 when none is asked)
+    final_xy_error: float = float("nan")
+    final_yaw_error: float = float("nan")
+    # what a failed task missed: "no plan", "state" (the wrong resting state), "position" (the right state, off by
+    # more than the goal's tolerance) or "yaw" (in place, turned wrong); "" on success
+    missed: str = ""
 
 
 @dataclass
@@ -73,7 +80,8 @@ class BenchReport:
                     success_by_scene={s: float(np.mean([r.success for r in rs if r.scene == s]))
                                       for s in sorted({r.scene for r in rs})},
                     rare_goal_states=dict(tasks=len(rare := [r for r in rs if _rare(r)]),
-                                          success=float(np.mean([r.success for r in rare])) if rare else None))
+                                          success=float(np.mean([r.success for r in rare])) if rare else None),
+                    failures=dict(Counter(r.missed for r in rs if not r.success)))
 
     def report(self) -> str:
         lines = ["versions: " + versions_text(),
@@ -87,6 +95,11 @@ class BenchReport:
             rare_text = f"{round(rare['success'] * rare['tasks'])}/{rare['tasks']}" if rare["tasks"] else "none"
             lines.append(f"{name:10s} {s['tasks']:5d} {s['success']:8.2f} {1e3 * s['median_planning_time_s']:16.0f} ms "
                          f"{s['mean_primitives']:16.1f} {s['mean_replans']:13.1f}  {scenes}; rare goal {rare_text}")
+        for name in dict.fromkeys(r.planner for r in self.results):
+            missed = self.summary(name)["failures"]
+            if missed:
+                lines.append(f"{name} failures, by what they missed: "
+                             + ", ".join(f"{k} {v}" for k, v in sorted(missed.items(), key=lambda kv: -kv[1])))
         return "\n".join(lines)
 
     def as_dict(self) -> dict:
@@ -154,10 +167,14 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
                       planner=planner_name, seed=seed, predictor=predictor)
     except AffordplanError as exc:
         return TaskResult(planner_name, task.scene, False, time.perf_counter() - t0, 0, 0, f"no plan: {exc}",
-                          p_goal)
+                          p_goal, missed="no plan")
     ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed)
     first = p.planning_time if planner_name == "affordplan" else ex.planning_time / max(1, ex.n_primitives)
-    return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal)
+    goal = task.goal
+    xy_error, yaw_error, state_ok = goal.errors(obj, ex.final_pose)
+    missed = "" if ex.success else "state" if not state_ok else "position" if xy_error > goal.xy_tol else "yaw"
+    return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal,
+                      float(xy_error), float(yaw_error), missed)
 
 
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),

@@ -534,15 +534,16 @@ def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
 def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
     from planner.bench import RARE_GOAL_STATE, BenchReport, TaskResult
 
-    def result(ok, p_goal):
-        return TaskResult("affordplan", "open", ok, 0.1, 5, 1, "", p_goal)
+    def result(ok, p_goal, missed=""):
+        return TaskResult("affordplan", "open", ok, 0.1, 5, 1, "", p_goal, missed=missed)
 
-    report = BenchReport([result(True, 0.4), result(True, 0.3), result(False, 0.02), result(True, 0.01),
-                          result(False, RARE_GOAL_STATE)])
+    report = BenchReport([result(True, 0.4), result(True, 0.3), result(False, 0.02, "state"), result(True, 0.01),
+                          result(False, RARE_GOAL_STATE, "yaw")])
     s = report.summary("affordplan")
     assert s["success"] == pytest.approx(3 / 5)  # rare goals stay in the success rate
     assert s["rare_goal_states"] == dict(tasks=2, success=0.5)
-    assert "rare goal 1/2" in report.report()
+    assert s["failures"] == {"state": 1, "yaw": 1}
+    assert "rare goal 1/2" in report.report() and "by what they missed: state 1, yaw 1" in report.report()
 
 
 def test_a_primitive_refused_before_any_physics_ends_the_execution():
