@@ -57,7 +57,7 @@ def versions() -> dict[str, str]:
 
 
 def versions_text(skip: tuple[str, ...] = ()) -> str:
-    """:func:`versions` as one line, ``"affordplan 0.10.0, mujoco 4.0.0, ..."``, less the names in ``skip``."""
+    """:func:`versions` as one line, ``"affordplan 0.11.0, mujoco 4.0.0, ..."``, less the names in ``skip``."""
     return ", ".join(f"{name} {v}" for name, v in versions().items() if name not in skip)
 
 
