@@ -73,14 +73,14 @@ class BenchReport:
         rs = [r for r in self.results if r.planner == planner]
         if not rs:
             return {}
+        rare = [r for r in rs if r.goal_state_probability < RARE_GOAL_STATE]
         return dict(planner=planner, tasks=len(rs), success=float(np.mean([r.success for r in rs])),
                     median_planning_time_s=float(np.median([r.planning_time for r in rs])),
                     mean_primitives=float(np.mean([r.primitives for r in rs])),
                     mean_replans=float(np.mean([r.replans for r in rs])),
                     success_by_scene={s: float(np.mean([r.success for r in rs if r.scene == s]))
                                       for s in sorted({r.scene for r in rs})},
-                    rare_goal_states=dict(tasks=len(rare := [r for r in rs if _rare(r)]),
-                                          reached=sum(r.success for r in rare)),
+                    rare_goal_states=dict(tasks=len(rare), reached=sum(r.success for r in rare)),
                     failures=dict(Counter(r.missed for r in rs if not r.success)))
 
     def report(self) -> str:
@@ -107,10 +107,6 @@ class BenchReport:
         names = list(dict.fromkeys(r.planner for r in self.results))
         return dict(versions=versions(), summary=[self.summary(n) for n in names],
                     tasks=[asdict(r) for r in self.results])
-
-
-def _rare(result: TaskResult) -> bool:
-    return result.goal_state_probability < RARE_GOAL_STATE
 
 
 def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...]:
