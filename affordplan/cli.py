@@ -136,8 +136,10 @@ def _cmd_bench_query(args: argparse.Namespace) -> int:
 def _cmd_bench_plan(args: argparse.Namespace) -> int:
     from planner.bench import bench_plan
 
+    log = (lambda text: print(text, file=sys.stderr, flush=True)) if args.log else None
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
-                        max_primitives=args.max_primitives, progress=not args.json)
+                        max_primitives=args.max_primitives, progress=not args.json and not args.log,
+                        only=args.task, log=log)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -191,14 +193,22 @@ def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_pr
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
 
-def _positive_int(text: str) -> int:
+def _int_at_least(text: str, low: int, what: str) -> int:
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+        raise argparse.ArgumentTypeError(f"expected a {what} integer, got {text!r}") from None
+    if value < low:
+        raise argparse.ArgumentTypeError(f"expected a {what} integer, got {value}")
     return value
+
+
+def _positive_int(text: str) -> int:
+    return _int_at_least(text, 1, "positive")
+
+
+def _nonnegative_int(text: str) -> int:
+    return _int_at_least(text, 0, "non-negative")
 
 
 def _register_robustness(bench_sub) -> None:
@@ -376,7 +386,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "trained on; prints success, median planning time, primitives and replans per task for "
                           "each planner."),
         epilog="examples:\n  affordplan bench plan --tasks 50 --sim arm --seed 0\n"
-               "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json",
+               "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json\n"
+               "  affordplan bench plan --seed 3 --task 22 42 --planner affordplan --log   # why they failed",
         formatter_class=_formatter,
     )
     bp.add_argument("--tasks", type=_positive_int, default=50, help="number of tasks (default: %(default)s)")
@@ -385,6 +396,10 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--planner", nargs="+", default=["affordplan", "greedy"], choices=["affordplan", "greedy"],
                     help="planners to compare (default: both)")
     bp.add_argument("--max-primitives", type=int, default=40, help="per task (default: %(default)s)")
+    bp.add_argument("--task", type=_nonnegative_int, nargs="+", default=None, metavar="I",
+                    help="run only these tasks of the seed's draw (the same tasks as in the whole run)")
+    bp.add_argument("--log", action="store_true",
+                    help="print each task's first plan and step-by-step execution log (to stderr)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     _register_robustness(bench_sub)

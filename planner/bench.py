@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 
 import networkx as nx
@@ -63,6 +64,7 @@ class TaskResult:
     # what a failed task missed: "no plan", "state" (the wrong resting state), "position" (the right state, off by
     # more than the goal's tolerance) or "yaw" (in place, turned wrong); "" on success
     missed: str = ""
+    task: int = -1  # index of the task in its seed's draw (object OBJECTS_PER_SEED * seed + task)
 
 
 @dataclass
@@ -154,7 +156,9 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
 
 
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
-             max_primitives: int, time_limit: float) -> TaskResult:
+             max_primitives: int, time_limit: float, log: Callable[[str], None] | None = None) -> TaskResult:
+    """Plan and execute ``task`` with one planner; ``log``, when given, receives the first plan and the
+    execution's step log (:class:`planner.execute.Execution`) as text."""
     from planner.api import plan as make_plan
 
     p_goal = float(obj.resting_states[task.goal.resting_state].probability)
@@ -163,9 +167,13 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
         p = make_plan(obj, task.goal, start=task.start, obstacles=task.obstacles, time_limit=time_limit,
                       planner=planner_name, seed=seed, predictor=predictor)
     except AffordplanError as exc:
+        if log is not None:
+            log(f"{planner_name}: no plan: {exc}")
         return TaskResult(planner_name, task.scene, False, time.perf_counter() - t0, 0, 0, f"no plan: {exc}",
                           p_goal, missed="no plan")
     ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed)
+    if log is not None:
+        log(f"{planner_name}: {p}\n{ex}")
     first = p.planning_time if planner_name == "affordplan" else ex.planning_time / max(1, ex.n_primitives)
     goal = task.goal
     xy_error, yaw_error, state_ok = goal.errors(obj, ex.final_pose)
@@ -174,17 +182,44 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
                       float(xy_error), float(yaw_error), missed)
 
 
+def _describe(task: Task) -> str:
+    """The task's start and goal, short: positions in metres, yaws in degrees."""
+    s, g = task.start, task.goal
+    goal_yaw = "any yaw" if g.yaw is None else f"yaw {math.degrees(g.yaw):+.0f} deg"
+    return (f"start state {s['resting_state']} at ({s['xy'][0]:.3f}, {s['xy'][1]:.3f}) yaw "
+            f"{math.degrees(s['yaw']):+.0f} deg; goal state {g.resting_state} at ({g.xy[0]:.3f}, {g.xy[1]:.3f}) "
+            f"{goal_yaw}")
+
+
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
-               max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True) -> BenchReport:
-    """Run ``n_tasks`` random tasks with each planner (see the module docstring)."""
+               max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
+               only: Sequence[int] | None = None, log: Callable[[str], None] | None = None) -> BenchReport:
+    """Run ``n_tasks`` random tasks with each planner (see the module docstring).
+
+    ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
+    run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
+    execution's step log.
+    """
     if not 0 < n_tasks <= OBJECTS_PER_SEED:
         raise InputError(f"n_tasks must be 1-{OBJECTS_PER_SEED} (seed S's tasks take test objects "
                          f"{OBJECTS_PER_SEED} S + i), got {n_tasks}")
+    wanted = range(n_tasks) if only is None else sorted(set(only))
+    if not wanted or not all(0 <= i < OBJECTS_PER_SEED for i in wanted):
+        raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
     rng = np.random.default_rng(seed)
     report = BenchReport()
-    for i in tqdm(range(n_tasks), desc=f"bench plan ({sim})", disable=not progress, unit="task"):
-        task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)
+    bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")
+    for i in range(max(wanted) + 1):
+        task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)  # drawn in order: task i is the same in any run
+        if i not in wanted:
+            continue
         predictor = Predictor(obj, seed=seed)
         for name in planners:
-            report.results.append(run_task(task, obj, name, sim, predictor, seed + i, max_primitives, time_limit))
+            if log is not None:
+                log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")
+            result = run_task(task, obj, name, sim, predictor, seed + i, max_primitives, time_limit, log)
+            result.task = i
+            report.results.append(result)
+        bar.update(1)
+    bar.close()
     return report

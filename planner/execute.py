@@ -48,13 +48,17 @@ class LogEntry:
     replanned: bool = False
     p_success: float = float("nan")
     note: str = ""
+    states: tuple[int, int] | None = None  # resting states before and after
 
     def __str__(self) -> str:
         (k, v), = self.params.items()
         value = f"{math.degrees(v):+.0f} deg" if k in ("direction", "angle") else f"state {v}"
         x0, y0, x1, y1 = self.pose_before[0, 3], self.pose_before[1, 3], self.pose_after[0, 3], self.pose_after[1, 3]
+        where = f"state {self.states[0]} " if self.states else ""
+        if self.states and self.states[1] != self.states[0]:
+            where = f"state {self.states[0]} -> {self.states[1]} "
         return (f"{self.index:2d}. {self.skill:4s} {k}={value:10s} ({x0:.3f}, {y0:.3f}) -> ({x1:.3f}, {y1:.3f}) "
-                f"{'ok ' if self.success else 'FAIL'}{' (replanned)' if self.replanned else ''}"
+                f"{where}{'ok ' if self.success else 'FAIL'}{' (replanned)' if self.replanned else ''}"
                 f"{' ' + self.note if self.note else ''}")
 
 
@@ -95,6 +99,10 @@ def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int)
     s = Simulator(obj, obstacles=obstacles, pusher=sim, seed=seed)
     s.set_object_pose(T_start)
     return s
+
+
+def _states(obj: ObjectModel, T_before: np.ndarray, T_after: np.ndarray) -> tuple[int, int]:
+    return obj.classify(T_before), obj.classify(T_after)
 
 
 def _off_plan(obj: ObjectModel, goal: Goal, T: np.ndarray, T_expected: np.ndarray) -> bool:
@@ -200,13 +208,15 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
             out = skill.execute(sim, step.params)
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
             planner.record_failure(step.skill, step.params, T)
-            log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc)))
+            log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc),
+                                _states(obj, T, T)))
             k = len(steps)
             continue
         if not made_progress(obj, step.skill, step.params, out.pose_before, out.pose_after):
             planner.record_failure(step.skill, step.params, T)
         log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
-                            out.pose_after, replanned, step.p_success))
+                            out.pose_after, replanned, step.p_success, states=_states(obj, out.pose_before,
+                                                                                      out.pose_after)))
         _record_frame(sim, render, frames)
         if (stop := _terminal(out)) is not None:
             reason = stop
@@ -257,10 +267,11 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
         try:
             out = predictor.skills[skill_name].execute(sim, prm)
         except AffordplanError as exc:  # e.g. ReachabilityError: the arm cannot reach the chosen contact
-            log.append(LogEntry(n, skill_name, prm, False, False, T, T, False, float(p[best]), str(exc)))
+            log.append(LogEntry(n, skill_name, prm, False, False, T, T, False, float(p[best]), str(exc),
+                                _states(obj, T, T)))
             continue
         log.append(LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
-                            False, float(p[best])))
+                            False, float(p[best]), states=_states(obj, out.pose_before, out.pose_after)))
         _record_frame(sim, render, frames)
         if (stop := _terminal(out)) is not None:
             reason = stop

@@ -174,6 +174,12 @@ def test_benchmark_counts_must_be_positive(argv, capsys):
     assert info.value.code == 2 and "expected a positive integer" in capsys.readouterr().err
 
 
+def test_bench_plan_task_indices_must_not_be_negative(capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["bench", "plan", "--task", "2", "-1"])
+    assert info.value.code == 2 and "expected a non-negative integer, got -1" in capsys.readouterr().err
+
+
 def test_cli_reports_library_errors_cleanly(capsys, tmp_path):
     assert cli.main(["render", "teapot"]) == 2
     assert "unknown object 'teapot'" in capsys.readouterr().err

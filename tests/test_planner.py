@@ -531,6 +531,37 @@ def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
         bench_plan(OBJECTS_PER_SEED + 1, seed=0, progress=False)
 
 
+def test_bench_runs_chosen_tasks_of_the_seed_s_draw_and_logs_their_executions():
+    """``only=[3]`` runs the task a whole run meets fourth (tasks are drawn in order), and the log shows its plan
+    and each executed primitive with the resting states it went between."""
+    from affordplan.errors import InputError
+    from planner.bench import OBJECTS_PER_SEED, _describe, bench_plan, make_task
+
+    rng = np.random.default_rng(2)
+    task = [make_task(rng, OBJECTS_PER_SEED * 2 + i)[0] for i in range(4)][3]
+    lines: list[str] = []
+    report = bench_plan(50, sim="finger", seed=2, planners=("greedy",), max_primitives=1, progress=False,
+                        only=[3], log=lines.append)
+    (result,) = report.results
+    assert result.task == 3 and result.primitives == 1
+    header, execution = lines
+    assert header.startswith(f"=== seed 2 task 3: test_{OBJECTS_PER_SEED * 2 + 3}_") and _describe(task) in header
+    assert "execution:" in execution and " 0. " in execution and "state " in execution
+    assert report.as_dict()["tasks"][0]["task"] == 3
+    with pytest.raises(InputError, match="task indices"):
+        bench_plan(50, seed=2, progress=False, only=[OBJECTS_PER_SEED])
+
+
+def test_the_step_log_names_the_resting_states_a_primitive_went_between():
+    from planner.execute import LogEntry
+
+    T = np.eye(4)
+    tipped = LogEntry(0, "push", {"direction": 0.0}, False, True, T, T, states=(2, 0))
+    kept = LogEntry(1, "roll", {"target": 3}, False, True, T, T, states=(0, 0))
+    assert "state 2 -> 0 FAIL" in str(tipped)
+    assert "state 0 FAIL" in str(kept) and "->  " not in str(kept)
+
+
 def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
     from planner.bench import RARE_GOAL_STATE, BenchReport, TaskResult
 
