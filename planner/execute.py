@@ -54,9 +54,10 @@ class LogEntry:
         (k, v), = self.params.items()
         value = f"{math.degrees(v):+.0f} deg" if k in ("direction", "angle") else f"state {v}"
         x0, y0, x1, y1 = self.pose_before[0, 3], self.pose_before[1, 3], self.pose_after[0, 3], self.pose_after[1, 3]
-        where = f"state {self.states[0]} " if self.states else ""
-        if self.states and self.states[1] != self.states[0]:
-            where = f"state {self.states[0]} -> {self.states[1]} "
+        where = ""
+        if self.states:
+            a, b = self.states
+            where = f"state {a} " if a == b else f"state {a} -> {b} "
         return (f"{self.index:2d}. {self.skill:4s} {k}={value:10s} ({x0:.3f}, {y0:.3f}) -> ({x1:.3f}, {y1:.3f}) "
                 f"{where}{'ok ' if self.success else 'FAIL'}{' (replanned)' if self.replanned else ''}"
                 f"{' ' + self.note if self.note else ''}")
