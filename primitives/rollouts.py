@@ -24,7 +24,6 @@ import queue
 from dataclasses import dataclass
 from typing import Protocol
 
-import mujoco
 import numpy as np
 import torch
 
@@ -32,7 +31,6 @@ from affordplan.errors import InputError
 from primitives.env import EnvConfig, PrimitiveEnv
 from primitives.networks import HybridActorCritic, choose_contact
 from primitives.scripted import scripted_push
-from primitives.teacher import com_in_observation, teacher_pushes
 
 # (observation (n_points, 9) float16, contact index, motion (3,) float32 in [-1, 1], reward, success, valid)
 Transition = tuple[np.ndarray, int, np.ndarray, float, bool, bool]
@@ -47,8 +45,6 @@ class Exploration:
     epsilon: float = 0.1  # share of uniformly drawn contacts
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion (motion units, [-1, 1])
     p_scripted: float = 0.0  # push only: share of actions replaced by a scripted push (primitives.scripted)
-    p_teacher: float = 0.0  # push only: share of episodes that become teacher episodes (primitives.teacher)
-    teacher_k: int = 8  # pushes a teacher episode executes from its start
 
 
 def act(model: HybridActorCritic, obs: np.ndarray, explore: Exploration, rng: np.random.Generator,
@@ -65,32 +61,6 @@ def act(model: HybridActorCritic, obs: np.ndarray, explore: Exploration, rng: np
     idx = int(choose_contact(q, explore.temperature, explore.epsilon, gen, greedy=False)[0])
     motion = actions[0, idx].numpy().astype(np.float64)
     return idx, np.clip(motion + rng.normal(0.0, explore.motion_noise, size=3), -1.0, 1.0)
-
-
-def explore_episode(model: HybridActorCritic, env: PrimitiveEnv, explore: Exploration, rng: np.random.Generator,
-                    gen: torch.Generator) -> list[Transition]:
-    """One exploring episode: its transitions (one, or ``explore.teacher_k`` for a teacher episode).
-
-    With probability ``explore.p_teacher`` (push only) the episode is a teacher episode
-    (:mod:`primitives.teacher`): pushes along the line through the true centre of mass, each executed from
-    the same start (the simulator's state is restored between them). With 0 no extra random number is
-    drawn, so runs without it are unchanged.
-    """
-    obs = env.reset()
-    if explore.p_teacher > 0.0 and rng.random() < explore.p_teacher:
-        sim, seen = env.sim, env.seen
-        com_obs = com_in_observation(sim.object_pose()[:3, 3], seen.points, seen.A_frame_world)
-        start = mujoco.MjData(sim.model)
-        mujoco.mj_copyData(start, sim.model, sim.data)
-        out = []
-        for idx, motion in teacher_pushes(obs, com_obs, explore.teacher_k, rng):
-            mujoco.mj_copyData(sim.data, sim.model, start)
-            res = env.step(idx, motion)
-            out.append((obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid))
-        return out
-    idx, motion = act(model, obs, explore, rng, gen)
-    res = env.step(idx, motion)
-    return [(obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid)]
 
 
 def worker_seed(seed: int, worker: int, global_step: int) -> int:
@@ -132,16 +102,16 @@ class Collector:
     def load_weights(self, state_dict: dict) -> None:
         self.model.load_state_dict(state_dict)
 
-    def episode(self) -> list[Transition]:
-        """Execute one exploring episode (:func:`explore_episode`)."""
-        return explore_episode(self.model, self.env, self.explore, self.rng, self.gen)
+    def step(self) -> Transition:
+        """Execute one exploring primitive."""
+        obs = self.env.reset()
+        idx, motion = act(self.model, obs, self.explore, self.rng, self.gen)
+        res = self.env.step(idx, motion)
+        return obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid
 
     def collect(self, n: int) -> tuple[list[Transition], float]:
-        """At least ``n`` transitions (whole episodes) and this process's resident memory in MB."""
-        out: list[Transition] = []
-        while len(out) < n:
-            out += self.episode()
-        return out, rss_mb()
+        """``n`` transitions and this process's resident memory in MB."""
+        return [self.step() for _ in range(n)], rss_mb()
 
     def close(self) -> None:
         self.env.close()
@@ -179,15 +149,15 @@ def _local_worker(env_config: EnvConfig, explore: Exploration, seed: int, weight
                 collector.load_weights(weights_q.get_nowait())
         except queue.Empty:
             pass
-        for transition in collector.episode():
-            while not stop.is_set():
-                try:
-                    out_q.put(transition, timeout=1.0)
-                    break
-                except queue.Full:
-                    if parent is not None and not parent.is_alive():
-                        collector.close()
-                        return
+        transition = collector.step()
+        while not stop.is_set():
+            try:
+                out_q.put(transition, timeout=1.0)
+                break
+            except queue.Full:
+                if parent is not None and not parent.is_alive():
+                    collector.close()
+                    return
         if parent is not None and not parent.is_alive():
             break
     collector.close()

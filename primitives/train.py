@@ -23,10 +23,6 @@ Read top to bottom, CleanRL style. Choices and why:
   actions by a scripted push along the line through the cloud's centre (:mod:`primitives.scripted`),
   which succeeds about twice as often as early exploration; the critic regresses rewards, so these
   off-policy samples need no correction.
-- **Teacher episodes (push, optional).** ``--p-teacher P`` turns a share P of the episodes into
-  teacher episodes (:mod:`primitives.teacher`): ``--teacher-k`` pushes along the line through the true
-  centre of mass, each from the same start, all entering the replay; the policy never sees the centre
-  of mass, the critic gets several outcomes for one observation.
 - **Invalid samples are dropped.** Primitives flagged by the physics guards never enter the replay.
 - **Workers.** ``--workers K`` runs K rollout workers (one torch thread each) that act with the
   latest weights and send transitions to this learner (:mod:`primitives.rollouts`): processes on
@@ -61,7 +57,7 @@ from primitives import checkpoint as ckpt
 from primitives.env import PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.networks import HybridActorCritic
 from primitives.replay import ReplayBuffer
-from primitives.rollouts import BACKENDS, Exploration, explore_episode, import_ray, make_source, rss_mb
+from primitives.rollouts import BACKENDS, Exploration, act, import_ray, make_source, rss_mb
 
 
 @dataclass
@@ -85,8 +81,6 @@ class TrainConfig:
     epsilon: float = 0.1  # uniform contact exploration (HACMan: 0.1)
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion
     p_scripted: float = 0.0  # push only: share of exploring actions replaced by a scripted push
-    p_teacher: float = 0.0  # push only: share of episodes that are teacher episodes (primitives.teacher)
-    teacher_k: int = 8  # pushes per teacher episode, all from the same start
     replay_size: int = 50_000
     learning_starts: int = 1_000
     replay_ratio: float = 8.0  # at most this many sampled transitions per collected one
@@ -108,7 +102,7 @@ def env_config(cfg: TrainConfig) -> EnvConfig:
 
 def exploration(cfg: TrainConfig) -> Exploration:
     """How the training policy explores (workers and the in-process collector alike)."""
-    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted, cfg.p_teacher, cfg.teacher_k)
+    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted)
 
 
 def _finite(x) -> bool:
@@ -117,8 +111,7 @@ def _finite(x) -> bool:
 
 # Settings the command line sets; the others are TrainConfig fields only.
 _CLI_SETTINGS = frozenset({"steps", "workers", "max_minutes", "checkpoint_minutes", "lr", "p_params", "p_scripted",
-                           "p_teacher", "teacher_k", "batch_size", "replay_size", "learning_starts",
-                           "weight_sync_updates", "n_points",
+                           "batch_size", "replay_size", "learning_starts", "weight_sync_updates", "n_points",
                            "torch_threads"})
 
 
@@ -135,8 +128,7 @@ def check_config(cfg: TrainConfig) -> None:
     counts = dict(steps=(cfg.steps, 1), workers=(cfg.workers, 0), batch_size=(cfg.batch_size, 1),
                   replay_size=(cfg.replay_size, cfg.batch_size), learning_starts=(cfg.learning_starts, 0),
                   n_points=(cfg.n_points, 16), torch_threads=(cfg.torch_threads, 1),
-                  weight_sync_updates=(cfg.weight_sync_updates, 1), teacher_k=(cfg.teacher_k, 1),
-                  log_every_steps=(cfg.log_every_steps, 1),
+                  weight_sync_updates=(cfg.weight_sync_updates, 1), log_every_steps=(cfg.log_every_steps, 1),
                   actor_delay=(cfg.actor_delay, 1), sim_cache=(cfg.sim_cache, 1), n_objects=(cfg.n_objects, 1))
     for name, (value, least) in counts.items():
         if not isinstance(value, int) or isinstance(value, bool) or value < least:
@@ -145,7 +137,7 @@ def check_config(cfg: TrainConfig) -> None:
         value = getattr(cfg, name)
         if not _finite(value) or value <= 0:
             raise InputError(f"{_setting(name)} must be a positive number, got {value!r}")
-    for name in ("p_params", "p_scripted", "p_teacher", "epsilon"):
+    for name in ("p_params", "p_scripted", "epsilon"):
         value = getattr(cfg, name)
         if not _finite(value) or not 0.0 <= value <= 1.0:
             raise InputError(f"{_setting(name)} is a probability in [0, 1], got {value!r}")
@@ -161,8 +153,6 @@ def check_config(cfg: TrainConfig) -> None:
         raise InputError("--ray-address needs --backend ray")
     if cfg.p_scripted > 0.0 and cfg.primitive != "push":
         raise InputError(f"--p-scripted exists for push only (primitives.scripted), not {cfg.primitive}")
-    if cfg.p_teacher > 0.0 and cfg.primitive != "push":
-        raise InputError(f"--p-teacher exists for push only (primitives.teacher), not {cfg.primitive}")
 
 
 # ---------------------------------------------------------------------------- learning
@@ -264,9 +254,10 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
         while state["global_step"] < cfg.steps and (time.time() - t_start) < 60 * cfg.max_minutes:
             # 1. Collect.
             if env is not None:
-                for transition in explore_episode(model, env, explore, rng, gen):
-                    if state["global_step"] < cfg.steps:
-                        add(*transition)
+                obs = env.reset()
+                idx, motion = act(model, obs, explore, rng, gen)
+                res = env.step(idx, motion)
+                add(obs, idx, motion, res.reward, res.success, res.valid)
             else:  # whatever the workers have sent; transitions beyond the step budget are dropped
                 for transition in source.poll(timeout=0.5 if replay.size < cfg.learning_starts else 0.0):
                     if state["global_step"] < cfg.steps:
@@ -377,12 +368,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--p-scripted", type=float, default=d.p_scripted,
                    help="push only: share of exploring actions replaced by a scripted push along the line "
                         "through the cloud's centre (primitives.scripted; default: %(default)s)")
-    p.add_argument("--p-teacher", type=float, default=d.p_teacher,
-                   help="push only: share of episodes that are teacher episodes, --teacher-k pushes along the "
-                        "line through the true centre of mass from one start (primitives.teacher; default: "
-                        "%(default)s)")
-    p.add_argument("--teacher-k", type=int, default=d.teacher_k,
-                   help="pushes per teacher episode (default: %(default)s)")
     p.add_argument("--init", default=None, help="start from these weights (e.g. primitives/weights/push.pt)")
     p.add_argument("--batch-size", type=int, default=d.batch_size)
     p.add_argument("--lr", type=float, default=d.lr)
@@ -405,8 +390,7 @@ def main(argv: list[str] | None = None) -> int:
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
         checkpoint_minutes=args.checkpoint_minutes, n_points=args.n_points, torch_threads=args.torch_threads,
-        p_params=args.p_params, p_scripted=args.p_scripted, p_teacher=args.p_teacher,
-        teacher_k=args.teacher_k, init=args.init,
+        p_params=args.p_params, p_scripted=args.p_scripted, init=args.init,
         weight_sync_updates=args.weight_sync_updates,
     )
     try:
