@@ -102,8 +102,10 @@ def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int)
     return s
 
 
-def _states(obj: ObjectModel, T_before: np.ndarray, T_after: np.ndarray) -> tuple[int, int]:
-    return obj.classify(T_before), obj.classify(T_after)
+def _states(obj: ObjectModel, T_before: np.ndarray, T_after: np.ndarray | None = None) -> tuple[int, int]:
+    """Resting states before and after a call (``T_after`` None: a call that did not run; classified once)."""
+    before = obj.classify(T_before)
+    return before, before if T_after is None else obj.classify(T_after)
 
 
 def _off_plan(obj: ObjectModel, goal: Goal, T: np.ndarray, T_expected: np.ndarray) -> bool:
@@ -210,7 +212,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
             planner.record_failure(step.skill, step.params, T)
             log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc),
-                                _states(obj, T, T)))
+                                _states(obj, T)))
             k = len(steps)
             continue
         if not made_progress(obj, step.skill, step.params, out.pose_before, out.pose_after):
@@ -269,7 +271,7 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
             out = predictor.skills[skill_name].execute(sim, prm)
         except AffordplanError as exc:  # e.g. ReachabilityError: the arm cannot reach the chosen contact
             log.append(LogEntry(n, skill_name, prm, False, False, T, T, False, float(p[best]), str(exc),
-                                _states(obj, T, T)))
+                                _states(obj, T)))
             continue
         log.append(LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
                             False, float(p[best]), states=_states(obj, out.pose_before, out.pose_after)))
