@@ -253,8 +253,8 @@ class Planner:
         if not self.workspace.contains(goal.xy):
             raise GoalError(f"goal xy={goal.xy} is outside the workspace {self.workspace}")
         checker = self.checkers[state]
-        if goal.yaw_free(self.obj, state):
-            yaws = list(np.linspace(-math.pi, math.pi, 12, endpoint=False))
+        if goal.yaw_free(self.obj, state):  # the yaws _free_yaw will try to place the object at the goal
+            yaws = list(FREE_YAW_STEPS)
         else:  # the goal's yaw and the yaws its state's symmetry makes equal to it
             period = goal.period(self.obj, state)
             yaws = [goal.yaw + k * period for k in range(int(round(2.0 * math.pi / period)))]

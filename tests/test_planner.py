@@ -590,3 +590,27 @@ def test_a_primitive_refused_before_any_physics_ends_the_execution():
     assert _terminal(pressed) is None
     assert "off_table" in _terminal(carried)
     assert _terminal(SimpleNamespace(valid=True, invalid_reason=None, n_steps=0)) is None
+
+
+def test_a_goal_free_only_in_a_narrow_band_of_yaws_is_accepted_and_reached():
+    """Bench seed 4, task 8: a yaw-free goal beside two blocks where the object fits at ~15 % of its yaws, none of
+    them on a 30 deg grid. The goal check tries the yaws the plan may place the object at (5 deg steps), so
+    the planner plans to it instead of calling it unreachable."""
+    from affordplan.objects.model import random_object
+
+    obj = random_object(4008, "test")
+    blocks = (ap.Box(center=(0.60781457, -0.05448863), size=(0.06, 0.06, 0.08), yaw=1.72963351),
+              ap.Box(center=(0.60182538, -0.06343740), size=(0.06, 0.06, 0.08), yaw=2.35014641),
+              ap.Box(center=(0.57140327, 0.01013276), size=(0.06, 0.06, 0.08), yaw=1.97854651))
+    goal = ap.Goal(xy=(0.68998982, -0.03508995), resting_state=0)
+    planner = _planner(obj, blocks)
+    checker = planner.checkers[0]
+    assert not any(checker.is_free(*goal.xy, a) for a in np.linspace(-math.pi, math.pi, 12, endpoint=False))
+    T0 = obj.resting_states[0].pose((0.389, 0.119), 2.95)
+    plan = planner.plan(T0, goal)
+    state, path = plan.paths[-1]
+    x, y, yaw = path[-1]
+    assert state == 0 and math.hypot(x - goal.xy[0], y - goal.xy[1]) < 1e-6
+    assert checker.is_free(x, y, yaw)  # the path ends at the goal, at one of the few yaws that fit
+    ex = execute_plan(plan, sim=ap.Simulator(obj, obstacles=blocks, pusher="finger", seed=0), max_primitives=30)
+    assert ex.success
