@@ -12,6 +12,7 @@ import pytest
 import affordplan as ap
 from affordplan.errors import GoalError, PlanningError
 from affordplan.geometry import wrap_angle
+from affordplan.objects.model import random_object
 from affordplan.sim.simulator import Outcome
 from planner import chain
 from planner.execute import execute_plan
@@ -596,8 +597,6 @@ def test_a_goal_free_only_in_a_narrow_band_of_yaws_is_accepted_and_reached():
     """Bench seed 4, task 8: a yaw-free goal beside two blocks where the object fits at ~15 % of its yaws, none of
     them on a 30 deg grid. The goal check tries the yaws the plan may place the object at (5 deg steps), so
     the planner plans to it instead of calling it unreachable."""
-    from affordplan.objects.model import random_object
-
     obj = random_object(4008, "test")
     blocks = (ap.Box(center=(0.60781457, -0.05448863), size=(0.06, 0.06, 0.08), yaw=1.72963351),
               ap.Box(center=(0.60182538, -0.06343740), size=(0.06, 0.06, 0.08), yaw=2.35014641),
