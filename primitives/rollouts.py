@@ -29,11 +29,13 @@ import torch
 
 from affordplan.errors import InputError
 from primitives.env import EnvConfig, PrimitiveEnv
+from primitives.hindsight import relabel
 from primitives.networks import HybridActorCritic, choose_contact
 from primitives.scripted import scripted_push
 
-# (observation (n_points, 9) float16, contact index, motion (3,) float32 in [-1, 1], reward, success, valid)
-Transition = tuple[np.ndarray, int, np.ndarray, float, bool, bool]
+# (observation (n_points, 9) float16, contact index, motion (3,) float32 in [-1, 1], reward, success, valid,
+#  relabelled: a hindsight copy of the primitive before it, not a primitive of its own)
+Transition = tuple[np.ndarray, int, np.ndarray, float, bool, bool, bool]
 BACKENDS = ("local", "ray")
 
 
@@ -45,6 +47,7 @@ class Exploration:
     epsilon: float = 0.1  # share of uniformly drawn contacts
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion (motion units, [-1, 1])
     p_scripted: float = 0.0  # push only: share of actions replaced by a scripted push (primitives.scripted)
+    hindsight: bool = False  # also send each primitive relabelled to other requests (primitives.hindsight)
 
 
 def act(model: HybridActorCritic, obs: np.ndarray, explore: Exploration, rng: np.random.Generator,
@@ -102,16 +105,23 @@ class Collector:
     def load_weights(self, state_dict: dict) -> None:
         self.model.load_state_dict(state_dict)
 
-    def step(self) -> Transition:
-        """Execute one exploring primitive."""
+    def step(self) -> list[Transition]:
+        """Execute one exploring primitive: its transition, then its hindsight copies (``explore.hindsight``)."""
         obs = self.env.reset()
+        seen = self.env.seen
         idx, motion = act(self.model, obs, self.explore, self.rng, self.gen)
         res = self.env.step(idx, motion)
-        return obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid
+        out = [(obs.astype(np.float16), idx, motion.astype(np.float32), res.reward, res.success, res.valid, False)]
+        if self.explore.hindsight:
+            for obs_h, motion_h, reward_h, success_h in relabel(self.env.config.primitive, self.env.sim.obj, seen,
+                                                                motion, res.outcome, res.success):
+                out.append((obs_h.astype(np.float16), idx, motion_h.astype(np.float32), reward_h, success_h,
+                            True, True))
+        return out
 
     def collect(self, n: int) -> tuple[list[Transition], float]:
-        """``n`` transitions and this process's resident memory in MB."""
-        return [self.step() for _ in range(n)], rss_mb()
+        """The transitions of ``n`` primitives (with their hindsight copies) and this process's memory in MB."""
+        return [t for _ in range(n) for t in self.step()], rss_mb()
 
     def close(self) -> None:
         self.env.close()
@@ -149,11 +159,11 @@ def _local_worker(env_config: EnvConfig, explore: Exploration, seed: int, weight
                 collector.load_weights(weights_q.get_nowait())
         except queue.Empty:
             pass
-        transition = collector.step()
-        while not stop.is_set():
+        transitions = collector.step()
+        while transitions and not stop.is_set():
             try:
-                out_q.put(transition, timeout=1.0)
-                break
+                out_q.put(transitions[0], timeout=1.0)
+                transitions.pop(0)
             except queue.Full:
                 if parent is not None and not parent.is_alive():
                     collector.close()

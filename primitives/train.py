@@ -23,6 +23,12 @@ Read top to bottom, CleanRL style. Choices and why:
   actions by a scripted push along the line through the cloud's centre (:mod:`primitives.scripted`),
   which succeeds about twice as often as early exploration; the critic regresses rewards, so these
   off-policy samples need no correction.
+- **Hindsight relabelling (optional).** ``--hindsight`` also stores each primitive as it scores under
+  the request it achieved (a 20 deg spin asked to turn 40 is a successful 20 deg spin) and under the
+  seed's objective (:mod:`primitives.hindsight`): exact rewards of the same outcome, so the critic sees
+  more successes and the unparameterised objective keeps being trained in a parameterised run. The
+  copies fill the replay but are not primitives: the step count, the replay ratio and the logged
+  success rates count executed primitives only.
 - **Invalid samples are dropped.** Primitives flagged by the physics guards never enter the replay.
 - **Workers.** ``--workers K`` runs K rollout workers (one torch thread each) that act with the
   latest weights and send transitions to this learner (:mod:`primitives.rollouts`): processes on
@@ -55,6 +61,7 @@ from tqdm import tqdm
 from affordplan.errors import InputError
 from primitives import checkpoint as ckpt
 from primitives.env import PRIMITIVES, EnvConfig, PrimitiveEnv
+from primitives.hindsight import relabel
 from primitives.networks import HybridActorCritic
 from primitives.replay import ReplayBuffer
 from primitives.rollouts import BACKENDS, Exploration, act, import_ray, make_source, rss_mb
@@ -81,6 +88,7 @@ class TrainConfig:
     epsilon: float = 0.1  # uniform contact exploration (HACMan: 0.1)
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion
     p_scripted: float = 0.0  # push only: share of exploring actions replaced by a scripted push
+    hindsight: bool = False  # also store each primitive relabelled to other requests (primitives.hindsight)
     replay_size: int = 50_000
     learning_starts: int = 1_000
     replay_ratio: float = 8.0  # at most this many sampled transitions per collected one
@@ -102,7 +110,7 @@ def env_config(cfg: TrainConfig) -> EnvConfig:
 
 def exploration(cfg: TrainConfig) -> Exploration:
     """How the training policy explores (workers and the in-process collector alike)."""
-    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted)
+    return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted, cfg.hindsight)
 
 
 def _finite(x) -> bool:
@@ -240,7 +248,10 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
     bar = tqdm(total=cfg.steps, initial=state["global_step"], disable=not progress, unit="step",
                desc=f"train {cfg.primitive}", mininterval=2.0)
 
-    def add(obs, idx, motion, reward, success, valid) -> None:
+    def add(obs, idx, motion, reward, success, valid, relabelled=False) -> None:
+        if relabelled:  # a hindsight copy of the primitive just added: replay only
+            replay.add(obs, idx, motion, reward, success)
+            return
         state["global_step"] += 1
         bar.update(1)
         if not valid:  # physics guard fired: never learned from
@@ -255,12 +266,20 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
             # 1. Collect.
             if env is not None:
                 obs = env.reset()
+                seen = env.seen
                 idx, motion = act(model, obs, explore, rng, gen)
                 res = env.step(idx, motion)
                 add(obs, idx, motion, res.reward, res.success, res.valid)
-            else:  # whatever the workers have sent; transitions beyond the step budget are dropped
+                if cfg.hindsight:
+                    for obs_h, motion_h, reward_h, success_h in relabel(cfg.primitive, env.sim.obj, seen, motion,
+                                                                        res.outcome, res.success):
+                        add(obs_h, idx, motion_h, reward_h, success_h, True, relabelled=True)
+            else:  # whatever the workers have sent; primitives beyond the step budget (and their copies) are dropped
+                keep = True
                 for transition in source.poll(timeout=0.5 if replay.size < cfg.learning_starts else 0.0):
-                    if state["global_step"] < cfg.steps:
+                    if not transition[6]:
+                        keep = state["global_step"] < cfg.steps
+                    if keep:
                         add(*transition)
             # 2. Learn, at most replay_ratio samples per collected transition.
             budget = cfg.replay_ratio * (state["global_step"] - state["invalid"]) / cfg.batch_size
@@ -368,6 +387,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--p-scripted", type=float, default=d.p_scripted,
                    help="push only: share of exploring actions replaced by a scripted push along the line "
                         "through the cloud's centre (primitives.scripted; default: %(default)s)")
+    p.add_argument("--hindsight", action="store_true",
+                   help="also store each primitive relabelled to the request it achieved and to the seed's "
+                        "objective (primitives.hindsight)")
     p.add_argument("--init", default=None, help="start from these weights (e.g. primitives/weights/push.pt)")
     p.add_argument("--batch-size", type=int, default=d.batch_size)
     p.add_argument("--lr", type=float, default=d.lr)
@@ -390,7 +412,7 @@ def main(argv: list[str] | None = None) -> int:
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
         checkpoint_minutes=args.checkpoint_minutes, n_points=args.n_points, torch_threads=args.torch_threads,
-        p_params=args.p_params, p_scripted=args.p_scripted, init=args.init,
+        p_params=args.p_params, p_scripted=args.p_scripted, hindsight=args.hindsight, init=args.init,
         weight_sync_updates=args.weight_sync_updates,
     )
     try:
