@@ -108,6 +108,17 @@ def _roll_axis(ups: np.ndarray) -> np.ndarray | None:
     return sign * axis / np.linalg.norm(axis)
 
 
+def _representative(members: list[int], probs: np.ndarray, ups: np.ndarray) -> int:
+    """The member pose a state is posed on: the likeliest one.
+
+    Mirror-image facets of a symmetric mesh tie (their probabilities agree to the last bits, or all
+    but the last); the tie is broken by the up-vector, the same key the states are sorted by. Left to
+    the order of ``compute_stable_poses`` the choice hung on how numpy's sort orders equal keys,
+    which differs between CPUs, and so did the state's pose at yaw 0 (a few degrees of tilt and yaw).
+    """
+    return min(members, key=lambda i: (-round(float(probs[i]), 9), *(-np.round(ups[i][::-1], 6))))
+
+
 def compute_resting_states(
     hull: trimesh.Trimesh, merge_angle: float = DEFAULT_MERGE_ANGLE,
     min_probability: float = MIN_PROBABILITY,
@@ -134,8 +145,7 @@ def compute_resting_states(
 
     states = []
     for members in groups.values():
-        members = sorted(members, key=lambda i: -probs[i])
-        best = members[0]
+        best = _representative(members, probs, ups)
         member_ups = ups[members]
         roll_axis = _roll_axis(member_ups)
         up = ups[best]
