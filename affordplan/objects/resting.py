@@ -38,7 +38,8 @@ class RestingState:
 
     Attributes:
         index: position in the object's list (sorted by probability, most likely first).
-        rotation: 3x3 ``R_world_object`` of the most likely member pose at yaw 0.
+        rotation: 3x3 ``R_world_object`` of the most likely member pose at yaw 0 (of tied mirror-image
+            members, the one with the smallest up-vector x, then y, then the largest z).
         height: the centre of mass above the table in that pose, metres.
         probability: quasi-static probability of landing in this state (sums to 1 over states).
         up: object-frame unit vector pointing up in ``rotation``.
