@@ -381,7 +381,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=d.seed)
     p.add_argument("--out", default=None, help="run folder (default: runs/PRIMITIVE)")
     p.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
-    p.add_argument("--max-minutes", type=float, default=d.max_minutes, help="wall-time budget")
+    p.add_argument("--max-minutes", type=float, default=d.max_minutes,
+                   help="wall-time budget of the whole run; a --resume counts the minutes already run")
     p.add_argument("--p-params", type=float, default=d.p_params,
                    help="share of episodes that ask for a parameter (default: %(default)s; 0 = seed objective)")
     p.add_argument("--p-scripted", type=float, default=d.p_scripted,
