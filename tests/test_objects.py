@@ -96,6 +96,7 @@ def test_resting_states_do_not_hang_on_the_order_stable_poses_come_in(monkeypatc
     for state, ref in zip(states, reference):
         assert state.probability == pytest.approx(ref.probability, abs=1e-12)
         np.testing.assert_allclose(state.rotation, ref.rotation, atol=1e-12)
+        np.testing.assert_allclose(state.member_ups, ref.member_ups, atol=1e-12)
         assert state.height == pytest.approx(ref.height, abs=1e-12)
 
 

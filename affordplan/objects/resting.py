@@ -44,7 +44,8 @@ class RestingState:
         probability: quasi-static probability of landing in this state (sums to 1 over states).
         up: object-frame unit vector pointing up in ``rotation``.
         heading: object-frame unit vector that defines yaw (see the module docstring).
-        member_ups: (k, 3) object-frame up-vectors of every merged stable pose.
+        member_ups: (k, 3) object-frame up-vectors of every merged stable pose, in the order of ``rotation``'s
+            tie rule (likeliest first).
         roll_axis: object-frame unit axis of a rolling family, else ``None``.
     """
 
@@ -109,22 +110,22 @@ def _roll_axis(ups: np.ndarray) -> np.ndarray | None:
     return sign * axis / np.linalg.norm(axis)
 
 
-def _representative(members: list[int], probs: np.ndarray, ups: np.ndarray) -> int:
-    """The member pose a state is posed on: the likeliest one.
+def _member_order(members: list[int], probs: np.ndarray, ups: np.ndarray) -> list[int]:
+    """A state's member poses, likeliest first; the first is the one the state is posed on.
 
     Mirror-image facets of a symmetric mesh tie (their probabilities agree to the last bits, or all
-    but the last); the tie goes to the smallest object-frame up-vector x, then y, then the largest z
-    (rounded to 1e-6). Left to the order of ``compute_stable_poses`` the choice hung on how numpy's
+    but the last); ties go to the smallest object-frame up-vector x, then y, then the largest z
+    (rounded to 1e-6). Left to the order of ``compute_stable_poses`` the order hung on how numpy's
     sort orders equal keys, which differs between CPUs, and so did the state's pose at yaw 0 (a few
     degrees of tilt, or a turn about a rolling family's axis: the mug lay leaning on one side of its
-    handle or the other). Of the 48 such lexicographic rules this one keeps the mug as the demo and
-    its figures have it.
+    handle or the other) and the order of ``member_ups``. Of the 48 such lexicographic rules this one
+    keeps the mug as the demo and its figures have it.
     """
     def key(i: int) -> tuple[float, ...]:
         x, y, z = (round(float(c), 6) for c in ups[i])
         return -round(float(probs[i]), 9), x, y, -z
 
-    return min(members, key=key)
+    return sorted(members, key=key)
 
 
 def compute_resting_states(
@@ -153,7 +154,8 @@ def compute_resting_states(
 
     states = []
     for members in groups.values():
-        best = _representative(members, probs, ups)
+        members = _member_order(members, probs, ups)
+        best = members[0]
         member_ups = ups[members]
         roll_axis = _roll_axis(member_ups)
         up = ups[best]
