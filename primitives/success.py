@@ -162,6 +162,12 @@ class Rollouts:
         z = np.load(path)
         return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"])
 
+    @classmethod
+    def concat(cls, parts: list[Rollouts]) -> Rollouts:
+        """The rollouts of ``parts``, in order."""
+        return cls(*(np.concatenate(a) for a in zip(*((r.obs, r.decision, r.success, r.group, r.parameterised)
+                                                        for r in parts))))
+
 
 @torch.no_grad()
 def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train", n_objects: int = 500,
@@ -227,6 +233,37 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
     env.close()
     return np.array(rating), Rollouts(np.stack(obs_l), np.stack(dec_l).astype(np.float32), np.array(succ),
                                       np.array(group), np.array(par))
+
+
+def worker_seed(seed: int, worker: int) -> int:
+    """The environment seed of collection worker ``worker``: worker 0 keeps ``seed``, so one worker collects
+    exactly what the in-process collector does."""
+    return seed + 100_003 * worker
+
+
+def _collect_share(fn, args: tuple, kwargs: dict):
+    torch.set_num_threads(1)
+    return fn(*args, **kwargs)
+
+
+def collect_parallel(fn, args: tuple, n: int, seed: int, workers: int = 1, progress: bool = True, **kwargs):
+    """``fn(*args, n_w, seed=worker_seed(seed, w), progress=..., **kwargs)`` (:func:`collect` or
+    :func:`collect_frame_search`) for ``w < workers`` in as many processes, their shares of ``n`` adding up to
+    ``n``; returns the shares' results in worker order. ``workers=1`` runs in this process. A given
+    ``(seed, workers)`` collects the same rollouts every time; another ``workers`` collects others."""
+    if workers < 1:
+        raise InputError(f"workers must be a positive integer, got {workers}")
+    shares = [n // workers + (w < n % workers) for w in range(workers)]
+    if workers == 1:
+        return [fn(*args, n, seed=seed, progress=progress, **kwargs)]
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn")) as pool:
+        futures = [pool.submit(_collect_share, fn, (*args, k),
+                               dict(kwargs, seed=worker_seed(seed, w), progress=progress and w == 0))
+                   for w, k in enumerate(shares) if k > 0]
+        return [f.result() for f in futures]
 
 
 def fit_frame_calibration(rating: np.ndarray, success: np.ndarray) -> tuple[float, float]:
@@ -474,6 +511,11 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--seed", type=int, default=0)
     f.add_argument("--out", default=None, help="folder for frames.json (default: runs/SKILL_frames)")
     f.add_argument("--json", action="store_true")
+    for name in ("train", "frames"):
+        sub.choices[name].add_argument(
+            "--workers", type=int, default=1,
+            help="processes collecting the rollouts, one torch thread each (default: 1); the rollouts depend on "
+                 "--seed and --workers")
     sub.choices["evaluate"].add_argument("--model", default=None, help="success model (default: shipped)")
     sub.choices["evaluate"].add_argument("--frames", default=None, metavar="shipped|PATH",
                                          help="judge the skill acting with this frame search (frames.json, or the "
@@ -505,6 +547,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--rollouts must be a positive integer, got {args.rollouts}")
     if getattr(args, "views", False) and args.frames is None:
         parser.error("--views needs --frames")
+    if getattr(args, "workers", 1) < 1:
+        parser.error(f"--workers must be a positive integer, got {args.workers}")
     if getattr(args, "members", 1) < 1:
         parser.error(f"--members must be a positive integer, got {args.members}")
     torch.set_num_threads(1)
@@ -527,24 +571,30 @@ def _run(args: argparse.Namespace) -> int:
         searched = args.frames is not None
         search = _load_frame_search(args.skill, args.frames) if searched else None
         cache = out / f"train_{'searched_' if searched else ''}rollouts_{args.rollouts}_{args.seed}.npz"
+        workers = f"_w{args.workers}" if args.workers > 1 else ""
+        cache = cache.with_name(cache.stem + workers + cache.suffix)
         if cache.exists():
             data = Rollouts.load(cache)
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model))
-            data = collect_frame_search(rater, args.skill, args.rollouts, search, "train", seed=args.seed,
-                                        progress=not args.json)[1]
+            data = Rollouts.concat([part[1] for part in collect_parallel(
+                collect_frame_search, (rater, args.skill), args.rollouts, args.seed, args.workers,
+                progress=not args.json, search=search, split="train")])
         else:
-            data = collect(policy, args.skill, args.rollouts, "train", seed=args.seed, progress=not args.json)
+            data = Rollouts.concat(collect_parallel(collect, (policy, args.skill), args.rollouts, args.seed,
+                                                    args.workers, progress=not args.json, split="train"))
         data.save(cache)
         views = FrameViews.of(data, policy, args.skill, search, progress=not args.json) if args.views else None
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
                         views=views)
-        info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped")
+        info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
+                    policy=args.policy or "shipped")
         if searched:
             info.update(frames=args.frames, model=args.model or "shipped")
         info["command"] = ("python -m primitives.success train " + args.skill + f" --rollouts {args.rollouts} "
                            f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
-                           + (f" --frames {args.frames}" if searched else "") + (" --views" if views else ""))
+                           + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
+                           + (f" --workers {args.workers}" if args.workers > 1 else ""))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
         return 0
@@ -574,20 +624,23 @@ def _run_frames(args: argparse.Namespace) -> int:
     search = FrameSearch(args.turns, args.mirror)
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
-    rating, data = collect_frame_search(model, args.skill, args.rollouts, search, "train", seed=args.seed,
-                                        progress=not args.json)
+    parts = collect_parallel(collect_frame_search, (model, args.skill), args.rollouts, args.seed, args.workers,
+                             progress=not args.json, search=search, split="train")
+    rating, data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
     success, par = data.success, data.parameterised
     platt = fit_frame_calibration(rating[par], success[par])
     platt_seed = fit_frame_calibration(rating[~par], success[~par]) if (~par).sum() >= 50 else (1.0, 0.0)
     search = FrameSearch(search.turns, search.mirror, platt, platt_seed)
     p = search.calibrate(rating, par)
-    info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, policy=args.policy or "shipped",
+    info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
+                policy=args.policy or "shipped",
                 model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
                 frames_seed_objective=len(search.frames(args.skill, None)), minutes=(time.perf_counter() - t0) / 60,
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
                 calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]),
                 command=f"python -m primitives.success frames {args.skill} --turns {args.turns}"
-                        f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts} --seed {args.seed}")
+                        f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts} --seed {args.seed}"
+                        f"{f' --workers {args.workers}' if args.workers > 1 else ''}")
     search = FrameSearch(search.turns, search.mirror, platt, platt_seed, info)
     search.save(out / "frames.json")
     print((out / "frames.json").read_text())

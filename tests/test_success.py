@@ -132,3 +132,21 @@ def test_frame_searched_rollouts_keep_the_goal_frame_view():
     data.group[:] = [1, 2, 3]  # one rollout per object: two to train on, one to calibrate
     net, info = success.fit(data, epochs=1, views=views, calib_fraction=0.34, progress=False)
     assert info["frame_views"] and (info["train"], info["calibration"]) == (2, 1)
+
+
+def test_parallel_collection_splits_the_rollouts_and_worker_0_keeps_the_seed():
+    """``--workers 2``: two processes, each its share of the rollouts from its own seed; worker 0's share is what
+    one in-process collector with the same seed gathers first."""
+    from primitives.skills import load_skill
+
+    policy = load_skill("push", frame_search=False).success_model.policy
+    parts = success.collect_parallel(success.collect, (policy, "push"), 5, seed=3, workers=2, progress=False,
+                                     split="train", n_objects=4)
+    assert [len(p) for p in parts] == [3, 2]
+    data = success.Rollouts.concat(parts)
+    assert len(data) == 5 and data.obs.shape[1:] == parts[0].obs.shape[1:]
+    alone = success.collect(policy, "push", 3, "train", n_objects=4, seed=3, progress=False)
+    assert np.array_equal(alone.obs, parts[0].obs) and np.array_equal(alone.success, parts[0].success)
+    assert not np.array_equal(parts[1].obs, alone.obs[:2])  # worker 1 draws other starts
+    with pytest.raises(success.InputError):
+        success.collect_parallel(success.collect, (policy, "push"), 5, seed=3, workers=0)
