@@ -591,9 +591,11 @@ def _run(args: argparse.Namespace) -> int:
                     policy=args.policy or "shipped")
         if searched:
             info.update(frames=args.frames, model=args.model or "shipped")
-        info["command"] = ("python -m primitives.success train " + args.skill + f" --rollouts {args.rollouts} "
+        info["command"] = ("python -m primitives.success train " + args.skill
+                           + (f" --policy {args.policy}" if args.policy else "") + f" --rollouts {args.rollouts} "
                            f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
                            + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
+                           + (f" --model {args.model}" if searched and args.model else "")
                            + (f" --workers {args.workers}" if args.workers > 1 else ""))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
@@ -638,7 +640,9 @@ def _run_frames(args: argparse.Namespace) -> int:
                 frames_seed_objective=len(search.frames(args.skill, None)), minutes=(time.perf_counter() - t0) / 60,
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
                 calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]),
-                command=f"python -m primitives.success frames {args.skill} --turns {args.turns}"
+                command=f"python -m primitives.success frames {args.skill}"
+                        f"{f' --policy {args.policy}' if args.policy else ''}"
+                        f"{f' --model {args.model}' if args.model else ''} --turns {args.turns}"
                         f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts} --seed {args.seed}"
                         f"{f' --workers {args.workers}' if args.workers > 1 else ''}")
     search = FrameSearch(search.turns, search.mirror, platt, platt_seed, info)
