@@ -49,7 +49,7 @@ DEMO_SCENE: dict[str, Any] = {
     "description": "The mug lies on its side behind a wall with a gap: flip it upright, push it through the gap "
                    "and turn it to face +y.",
     "object": "mug",
-    "start": {"resting_state": 0, "xy": [0.45, -0.05], "yaw_deg": -150.0},
+    "start": {"resting_state": 0, "xy": [0.45, -0.05], "yaw_deg": 29.0},
     "goal": {"xy": [0.69, 0.0], "resting_state": 1, "yaw_deg": 90.0},
     "obstacles": [
         {"center": [0.6, -0.21], "size": [0.02, 0.2, 0.1]},

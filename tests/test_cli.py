@@ -27,7 +27,7 @@ def test_example_json_scene_is_the_demo_scene():
     scene = load_scene(SCENES / "mug_wall.json")
     assert scene == demo_scene()
     assert scene.name == "mug_wall" and scene.object == "mug"
-    assert scene.start == {"resting_state": 0, "xy": (0.45, -0.05), "yaw": pytest.approx(math.radians(-150.0))}
+    assert scene.start == {"resting_state": 0, "xy": (0.45, -0.05), "yaw": pytest.approx(math.radians(29.0))}
     assert scene.goal.resting_state == 1 and scene.goal.yaw == pytest.approx(math.pi / 2)
     assert [b.center for b in scene.obstacles] == [(0.6, -0.21), (0.6, 0.21)]
 
