@@ -570,9 +570,8 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "train":
         searched = args.frames is not None
         search = _load_frame_search(args.skill, args.frames) if searched else None
-        cache = out / f"train_{'searched_' if searched else ''}rollouts_{args.rollouts}_{args.seed}.npz"
         workers = f"_w{args.workers}" if args.workers > 1 else ""
-        cache = cache.with_name(cache.stem + workers + cache.suffix)
+        cache = out / f"train_{'searched_' if searched else ''}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
         if cache.exists():
             data = Rollouts.load(cache)
         elif searched:
