@@ -62,6 +62,7 @@ class SkillObservation:
     obs: np.ndarray  # (n, OBS_DIM) float32, the policy's input (goal frame)
     params: dict | None  # checked parameters
     A_frame_world: np.ndarray  # (3, 3) world vectors -> goal frame
+    acted_as: dict | None = None  # the stand-in request the policy is shown for params None (primitives.frames)
 
     def motion_to_world(self, motion: np.ndarray) -> np.ndarray:
         """A goal-frame motion in [-1, 1]^3 as a world-frame one, clipped to [-1, 1]^3 per world axis as

@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
 from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
-from primitives.frames import FrameSearch, select_frame
+from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic, widen_input
 
 # The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
@@ -81,6 +81,7 @@ class EvalResult:
     frames: str = "goal frame"  # or "best of M free frames" (frame search)
     predicted: list[float] = field(default_factory=list)  # the success model's rating of each trial (frame search)
     outcomes: list[bool] = field(default_factory=list)  # every trial's success, in order
+    acted_as: list[dict | None] = field(default_factory=list)  # each trial's stand-in request (frame search only)
 
     @property
     def success_rate(self) -> float:
@@ -104,6 +105,10 @@ class EvalResult:
                    per_object=self.rates())
         if self.predicted:
             out.update(frames=self.frames, calibration=self.calibration())
+        stand_ins = [a is not None for a in self.acted_as]
+        if any(stand_ins):
+            out.update(stand_in_share=float(np.mean(stand_ins)),
+                       stand_in_success=float(np.mean([o for o, a in zip(self.outcomes, stand_ins) if a])))
         return out
 
 
@@ -141,13 +146,16 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
     for key in tqdm(plan, desc=f"evaluate {primitive}", disable=not progress, unit="trial", mininterval=2.0):
         obs = env.reset(object_key=key)
         if predict is not None:
-            frames = frame_search.frames(primitive, env.seen.params)
-            env.seen, rating = select_frame(env.seen, predict, frames)
+            searched = frame_search.searches(primitive, env.seen.params)
+            stand_ins = env.seen.params is None and frame_search.stand_ins > 0 and primitive != "spin"
+            env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim)
             obs = env.seen.obs
-            if len(frames) > 1:
-                result.frames = f"best of {len(frames)} free frames"
+            if searched:
+                result.frames = (f"best of {len(frame_search.frames(primitive, env.seen.params))} free frames"
+                                 + (" and the stand-in requests' frames" if stand_ins else ""))
                 rating = float(frame_search.calibrate(rating, env.seen.params is not None))
             result.predicted.append(rating)
+            result.acted_as.append(env.seen.acted_as)
         idx, motion, _ = greedy_action(model, obs)
         res = env.step(idx, motion)
         result.invalid += not res.valid
@@ -298,6 +306,10 @@ def main(argv: list[str] | None = None) -> int:
         if cal is not None:
             print(f"  {result.frames}; success model on the chosen frames: mean rating {cal['mean_prediction']:.3f}, "
                   f"ECE {cal['ece']:.3f}, Brier {cal['brier']:.3f}, AUROC {cal['auroc']:.3f}")
+        d = result.as_dict()
+        if "stand_in_share" in d:
+            print(f"  acted as a stand-in request on {d['stand_in_share']:.3f} of the trials "
+                  f"(success there {d['stand_in_success']:.3f})")
         for name, rate in result.rates().items():
             seed = SEED_FIG5.get(name)
             ref = f"   seed {seed[PRIMITIVES.index(args.primitive)]:.3f}" if seed else ""

@@ -8,6 +8,17 @@ about the vertical or is mirrored through a vertical plane):
 - push with a direction, roll to a target: the mirror ``y -> -y`` (the turn is taken: it aims the request at +x);
 - the seed's objective (no parameter): any turn, and the mirror.
 
+**Stand-in requests** (``FrameSearch.stand_ins``). The seed's objective asks for less than some requests do: a
+push that moved 5 cm within 15 deg of an asked direction without turning 5 deg met the seed's push criterion
+too, and a roll into a neighbouring resting state tips the object about a horizontal axis, as the seed's roll
+criterion asks (by at least 60 deg where the state's dihedral angle is that large, as on most objects). So a
+search for the seed's objective may also try the policy *as if asked* for each such request in its free frames
+and act on whichever the success model rates likeliest: push ``stand_ins`` evenly spaced directions, roll every
+state one roll away. (Spin has none: an asked angle of 30-40 deg may be met by a turn under the seed's 30.) The
+outcome is still judged by the seed's criterion. The policy conditioned on a direction pushes straighter than it
+does unconditioned (0.12: 200 held-out starts, the seed's objective 0.52 by 24 frames alone, 0.69 with 24
+directions added).
+
 The policy is a point-cloud network trained from samples, so it is not invariant under these frames. Its success
 on one start differs with the frame it sees the start in: the spin success model gives the same 35 deg spin of
 one held-out object 0.63 at yaw 0 and 0.02 at yaw 1 rad. Each frame shows the policy a start it could equally
@@ -32,13 +43,18 @@ import math
 import os
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.special import expit, logit
 
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z
-from primitives.env import OBS_DIM, SkillObservation
+from primitives import params as skill_params
+from primitives.env import OBS_DIM, SkillObservation, observe_cloud
+
+if TYPE_CHECKING:
+    from affordplan.sim import Simulator
 
 MIRROR_Y = np.diag([1.0, -1.0, 1.0])
 
@@ -87,6 +103,17 @@ def select_frame(seen: SkillObservation, predict, frames: np.ndarray) -> tuple[S
     return reframe(seen, frames[best]), float(p[best])
 
 
+def stand_in_requests(skill: str, n: int, obj, state: int) -> list[dict]:
+    """The requests whose success meets the seed's objective for ``skill`` that a search with ``n`` stand-ins
+    tries (module docstring): push ``n`` directions evenly spaced from -pi (radians), roll each target state one
+    roll away from ``state`` (any ``n > 0``), spin none. Empty for ``n == 0``."""
+    if n <= 0 or skill == "spin":
+        return []
+    if skill == "push":
+        return [{"direction": -math.pi + 2.0 * math.pi * k / n} for k in range(n)]
+    return [{"target": t} for t in skill_params.roll_targets(obj, state)]
+
+
 @dataclass(frozen=True)
 class FrameSearch:
     """Which free frames a skill tries, and the calibration of the chosen frame's rating.
@@ -94,7 +121,10 @@ class FrameSearch:
     ``turns``: turns about the vertical where the turn is free (1: none); ``mirror``: the mirror too, where it is
     free; ``platt``: ``(a, b)`` of ``sigmoid(a logit(p) + b)`` on the best rating ``p`` of a request with a
     parameter, ``platt_unparameterised`` the same for the seed's objective (which leaves more frames free, so its
-    best rating is biased more); ``(1, 0)``: none. ``info``: how the calibration was made (command, figures).
+    best rating is biased more); ``(1, 0)``: none. ``stand_ins``: for the seed's objective, also try the
+    stand-in requests (:func:`stand_in_requests`; push: that many directions, a multiple of ``turns`` so that
+    the set tried is the same from every frame; roll: any number > 0; 0: none). ``info``: how the calibration
+    was made (command, figures).
     """
 
     turns: int = 1
@@ -102,15 +132,53 @@ class FrameSearch:
     platt: tuple[float, float] = (1.0, 0.0)
     platt_unparameterised: tuple[float, float] = (1.0, 0.0)
     info: dict = field(default_factory=dict, compare=False)
+    stand_ins: int = 0
 
     def __post_init__(self):
         free_frames("spin", None, self.turns, self.mirror)  # checks turns
+        if (not isinstance(self.stand_ins, int) or isinstance(self.stand_ins, bool) or self.stand_ins < 0
+                or (self.stand_ins and self.stand_ins % self.turns)):
+            raise InputError(f"stand_ins must be 0 or a whole multiple of turns ({self.turns}), got {self.stand_ins!r}")
         for ab in (self.platt, self.platt_unparameterised):
             if len(ab) != 2 or not all(math.isfinite(v) for v in ab):
                 raise InputError(f"a FrameSearch Platt scaling must be two finite numbers, got {ab!r}")
 
     def frames(self, skill: str, params: dict | None) -> np.ndarray:
         return free_frames(skill, params, self.turns, bool(self.mirror))
+
+    def searches(self, skill: str, params: dict | None) -> bool:
+        """Whether a request ``params`` of ``skill`` leaves this search more than one option to rate."""
+        return len(self.frames(skill, params)) > 1 or (params is None and self.stand_ins > 0 and skill != "spin")
+
+    def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator) -> tuple[SkillObservation, float]:
+        """The observation to act on and its raw rating: ``seen`` (of ``sim``'s current cloud) in the free frame,
+        or for the seed's objective the free frame of the stand-in request, that ``predict`` (observations
+        ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch.
+
+        The returned observation keeps ``seen.params`` (what the outcome is judged by); ``acted_as`` names the
+        stand-in request where one was chosen. The rating is raw: :meth:`calibrate` it with
+        ``seen.params is not None``.
+        """
+        frames = self.frames(skill, seen.params)
+        options = [(seen, frames)]
+        if seen.params is None and self.stand_ins:
+            T_world_object = sim.object_pose()
+            state = sim.obj.classify(T_world_object)
+            for request in stand_in_requests(skill, self.stand_ins, sim.obj, state):
+                request = skill_params.check(skill, request, sim.obj, state)
+                asked = observe_cloud(sim.obj, skill, request, seen.points, seen.normals, T_world_object)
+                options.append((asked, self.frames(skill, request)))
+        if len(options) == 1:
+            return select_frame(seen, predict, frames)
+        p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])))
+        best = int(np.argmax(p))
+        ends = np.cumsum([len(f) for _, f in options])
+        k = int(np.searchsorted(ends, best, side="right"))
+        option, option_frames = options[k]
+        chosen = reframe(option, option_frames[best - (int(ends[k - 1]) if k else 0)])
+        if chosen.params is not None:
+            chosen = replace(chosen, params=seen.params, acted_as=chosen.params)
+        return chosen, float(p.max())
 
     def calibrate(self, p: np.ndarray | float, parameterised: np.ndarray | bool = True) -> np.ndarray:
         """The calibrated probability of the best ratings ``p`` of requests with (or without) a parameter;
@@ -130,6 +198,7 @@ class FrameSearch:
         try:
             d = json.loads(Path(path).read_text())
             return cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
-                       tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}))
+                       tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}),
+                       int(d.get("stand_ins", 0)))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc

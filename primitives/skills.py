@@ -36,7 +36,7 @@ from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.env import PRIMITIVES, SkillObservation, skill_observation
 from primitives.evaluate import greedy_action, load_policy
-from primitives.frames import FrameSearch, reframe_obs, select_frame
+from primitives.frames import FrameSearch, reframe_obs
 from primitives.networks import HybridActorCritic
 from primitives.success import WEIGHTS_DIR, SuccessModel, load_success_net
 
@@ -66,16 +66,16 @@ class Skill:
     def _observe_rated(self, sim: Simulator, params=None) -> tuple[SkillObservation, float | None]:
         """:meth:`observe` and, where frames were searched, the calibrated rating of the chosen one."""
         seen = skill_observation(sim, self.name, params, self.n_points)
-        frames = self.frames(seen.params)
-        if len(frames) == 1:
+        if self.frame_search is None or not self.frame_search.searches(self.name, seen.params):
             return seen, None
-        seen, p = select_frame(seen, self.success_model.predict, frames)
+        seen, p = self.frame_search.select(self.name, seen, self.success_model.predict, sim)
         return seen, float(self.frame_search.calibrate(p, seen.params is not None))
 
     def observe(self, sim: Simulator, params=None) -> SkillObservation:
         """Cloud, the policy's observation, the checked params and the goal frame (raises InputError).
 
-        With a frame search, the goal frame is the free frame the success model rates likeliest.
+        With a frame search, the goal frame is the free frame the success model rates likeliest (for the seed's
+        objective, of the stand-in requests' as well: ``acted_as``; :mod:`primitives.frames`).
         """
         return self._observe_rated(sim, params)[0]
 
@@ -147,7 +147,9 @@ class Skill:
     def success_probability_obs(self, obs: np.ndarray, parameterised: bool = True) -> np.ndarray:
         """Predicted P(success) for observations ``(N, 9)`` or ``(B, N, 9)`` built in the goal frame
         (:func:`primitives.env.observe_cloud`), all with a parameter or all without; with a frame search, the
-        searched success model's answer, or without one the calibrated rating of the best free frame."""
+        searched success model's answer, or without one the calibrated rating of the best free frame (for the
+        seed's objective a lower bound where the search has stand-ins: rating those needs the object and its
+        resting state, which an observation does not carry; :meth:`success_probability` rates them)."""
         if self.searched_model is not None:
             return self.searched_model.predict(obs)
         frames = self.frames({} if parameterised else None)

@@ -31,7 +31,7 @@ import os
 import sys
 import time
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -208,8 +208,6 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
     rates the searched skill from the goal frame alone (:func:`fit`).
     """
     from primitives.evaluate import greedy_action
-    from primitives.frames import select_frame
-
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
     rating, obs_l, dec_l, succ, group, par = [], [], [], [], [], []
@@ -217,7 +215,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
                mininterval=2.0)
     while len(succ) < n:
         obs = env.reset()
-        env.seen, p = select_frame(env.seen, model.predict, search.frames(skill, env.seen.params))
+        env.seen, p = search.select(skill, env.seen, model.predict, env.sim)
         idx, motion, _ = greedy_action(model.policy, env.seen.obs)
         res = env.step(idx, motion)
         if not res.valid:
@@ -507,6 +505,9 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--model", default=None, help="success model rating the frames (default: shipped)")
     f.add_argument("--turns", type=int, default=12, help="turns about the vertical, where free (default: 12)")
     f.add_argument("--mirror", action="store_true", help="also the mirrored frames, where free")
+    f.add_argument("--stand-ins", type=int, default=0, metavar="N",
+                   help="for the seed's objective, also try the stand-in requests (primitives.frames): push N "
+                        "directions (a multiple of --turns), roll every state one roll away (N > 0); default: none")
     f.add_argument("--rollouts", type=int, default=2000)
     f.add_argument("--seed", type=int, default=0)
     f.add_argument("--out", default=None, help="folder for frames.json (default: runs/SKILL_frames)")
@@ -622,7 +623,7 @@ def _run_frames(args: argparse.Namespace) -> int:
 
     out = Path(args.out or f"runs/{args.skill}_frames")
     out.mkdir(parents=True, exist_ok=True)
-    search = FrameSearch(args.turns, args.mirror)
+    search = FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
     parts = collect_parallel(collect_frame_search, (model, args.skill), args.rollouts, args.seed, args.workers,
@@ -631,20 +632,23 @@ def _run_frames(args: argparse.Namespace) -> int:
     success, par = data.success, data.parameterised
     platt = fit_frame_calibration(rating[par], success[par])
     platt_seed = fit_frame_calibration(rating[~par], success[~par]) if (~par).sum() >= 50 else (1.0, 0.0)
-    search = FrameSearch(search.turns, search.mirror, platt, platt_seed)
+    search = replace(search, platt=platt, platt_unparameterised=platt_seed)
     p = search.calibrate(rating, par)
     info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
                 policy=args.policy or "shipped",
                 model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
-                frames_seed_objective=len(search.frames(args.skill, None)), minutes=(time.perf_counter() - t0) / 60,
+                frames_seed_objective=len(search.frames(args.skill, None)), stand_ins=args.stand_ins,
+                minutes=(time.perf_counter() - t0) / 60,
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
                 calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]),
                 command=f"python -m primitives.success frames {args.skill}"
                         f"{f' --policy {args.policy}' if args.policy else ''}"
                         f"{f' --model {args.model}' if args.model else ''} --turns {args.turns}"
-                        f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts} --seed {args.seed}"
+                        f"{' --mirror' if args.mirror else ''}"
+                        f"{f' --stand-ins {args.stand_ins}' if args.stand_ins else ''}"
+                        f" --rollouts {args.rollouts} --seed {args.seed}"
                         f"{f' --workers {args.workers}' if args.workers > 1 else ''}")
-    search = FrameSearch(search.turns, search.mirror, platt, platt_seed, info)
+    search = replace(search, info=info)
     search.save(out / "frames.json")
     print((out / "frames.json").read_text())
     return 0

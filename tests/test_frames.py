@@ -8,8 +8,17 @@ import pytest
 import affordplan as ap
 from affordplan.errors import InputError
 from primitives import params as skill_params
-from primitives.env import observation, skill_observation
-from primitives.frames import MIRROR_Y, FrameSearch, free_frames, reframe, reframe_obs, select_frame
+from primitives import rewards
+from primitives.env import observation, observe_cloud, skill_observation
+from primitives.frames import (
+    MIRROR_Y,
+    FrameSearch,
+    free_frames,
+    reframe,
+    reframe_obs,
+    select_frame,
+    stand_in_requests,
+)
 
 
 def test_each_request_leaves_its_own_frames_free():
@@ -55,6 +64,58 @@ def test_select_frame_takes_the_best_rated_frame():
 
     chosen, p = select_frame(seen, predict, frames)
     assert np.allclose(chosen.A_frame_world, frames[wanted] @ seen.A_frame_world) and p == pytest.approx(1.0)
+
+
+def test_stand_in_requests_are_requests_whose_success_meets_the_seeds_objective():
+    cube = ap.load_object("cube")
+    dirs = [r["direction"] for r in stand_in_requests("push", 24, cube, 0)]
+    assert len(dirs) == 24 and dirs[0] == pytest.approx(-math.pi) and np.allclose(np.diff(dirs), 2 * math.pi / 24)
+    assert stand_in_requests("roll", 1, cube, 0) == [{"target": t} for t in skill_params.roll_targets(cube, 0)]
+    assert stand_in_requests("spin", 24, cube, 0) == [] and stand_in_requests("push", 0, cube, 0) == []
+    # any push that met an asked direction met the seed's push criterion (random planar motions of the cube)
+    rng = np.random.default_rng(0)
+    met = 0
+    for _ in range(2000):
+        T1 = np.eye(4)
+        T1[:3, :3] = ap.geometry.rot_z(rng.normal(0.0, 0.08))
+        T1[:2, 3] = rng.uniform(-0.09, 0.09, 2)
+        direction = float(rng.uniform(-math.pi, math.pi))
+        if rewards.success("push", np.eye(4), T1, {"direction": direction}):
+            met += 1
+            assert rewards.success("push", np.eye(4), T1, None)
+    assert met > 20
+    with pytest.raises(InputError, match="multiple of turns"):
+        FrameSearch(12, True, stand_ins=18)
+    with pytest.raises(InputError):
+        FrameSearch(12, True, stand_ins=-12)
+
+
+def test_a_search_for_the_seeds_objective_may_act_as_asked_for_a_stand_in(tmp_path):
+    sim = ap.Simulator(ap.load_object("cube"), seed=0)
+    sim.reset()
+    seen = skill_observation(sim, "push", None, 64)
+    search = FrameSearch(4, True, stand_ins=8)
+    state = sim.obj.classify(sim.object_pose())
+    wanted = stand_in_requests("push", 8, sim.obj, state)[3]
+    target = reframe(observe_cloud(sim.obj, "push", wanted, seen.points, seen.normals, sim.object_pose()), MIRROR_Y)
+
+    def near_target(obs):  # rates the mirrored frame of the 4th direction
+        return np.exp(-np.abs(obs - target.obs).sum(axis=(1, 2)))
+
+    chosen, p = search.select("push", seen, near_target, sim)
+    assert chosen.params is None and chosen.acted_as == wanted and p == pytest.approx(1.0)
+    assert np.allclose(chosen.obs, target.obs) and np.allclose(chosen.A_frame_world, target.A_frame_world)
+
+    def no_flow(obs):  # rates the seed's own observations (no goal flow) highest
+        return 1.0 / (1.0 + np.abs(obs[..., 6:]).sum(axis=(1, 2)))
+
+    own, _ = search.select("push", seen, no_flow, sim)
+    assert own.acted_as is None and np.allclose(own.obs[:, 6:], 0.0)
+    asked = skill_observation(sim, "push", {"direction": 0.3}, 64)  # a request with a parameter has no stand-ins
+    kept, _ = search.select("push", asked, near_target, sim)
+    assert kept.acted_as is None and kept.params == asked.params
+    search.save(tmp_path / "f.json")
+    assert FrameSearch.load(tmp_path / "f.json").stand_ins == 8
 
 
 def test_frame_search_calibration_and_files(tmp_path):
@@ -181,3 +242,33 @@ def test_the_shipped_skills_rate_with_their_shipped_searched_success_model(name)
     assert load_success_net(name, WEIGHTS_DIR / f"{name}_success_searched.pt").members
     assert load_skill(name, searched=False).searched_model is None
     assert load_skill(name, frame_search=False).searched_model is None
+
+
+def test_a_skill_acting_as_a_stand_in_is_judged_by_the_seeds_objective():
+    from primitives import load_skill
+
+    skill = load_skill("push", frame_search=FrameSearch(12, True, stand_ins=24))
+
+    def fresh():
+        sim = ap.Simulator(ap.load_object("pill_bottle"), seed=0)
+        sim.reset()
+        return sim
+
+    assert skill.observe(fresh(), None).acted_as is not None  # a direction of the 24 is rated above every frame
+    sim = fresh()
+    out = skill.execute(sim, None)
+    moved = out.pose_after[:3, 3] - out.pose_before[:3, 3]
+    assert out.success and rewards.success("push", out.pose_before, out.pose_after, None)
+    assert np.linalg.norm(moved[:2]) >= 0.05
+
+
+def test_evaluation_with_stand_ins_counts_the_trials_acted_as_one():
+    from primitives.evaluate import evaluate, load_policy
+
+    model = load_policy(None, "push")
+    search = FrameSearch(12, True, stand_ins=24)
+    d = evaluate(model, "push", ("pill_bottle",), trials=4, seed=3, progress=False, frame_search=search).as_dict()
+    assert "stand-in" in d["frames"] and 0.0 < d["stand_in_share"] <= 1.0 and len(d["per_object"]) == 1
+    asked = evaluate(model, "push", ("pill_bottle",), trials=2, seed=3, progress=False, p_params=1.0,
+                     frame_search=search).as_dict()
+    assert "stand_in_share" not in asked and asked["frames"] == "best of 2 free frames"  # a direction: mirror only
