@@ -147,7 +147,7 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
         obs = env.reset(object_key=key)
         if predict is not None:
             searched = frame_search.searches(primitive, env.seen.params)
-            stand_ins = env.seen.params is None and frame_search.stand_ins > 0 and primitive != "spin"
+            stand_ins = env.seen.params is None and frame_search.stand_ins > 0
             env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim)
             obs = env.seen.obs
             if searched:

@@ -9,25 +9,19 @@ about the vertical or is mirrored through a vertical plane):
 - the seed's objective (no parameter): any turn, and the mirror.
 
 **Stand-in requests** (``FrameSearch.stand_ins``). The seed's objective asks for less than some requests do: a
-push that moved 5 cm within 15 deg of an asked direction without turning 5 deg met the seed's push criterion
-too, and a roll into a neighbouring resting state tips the object about a horizontal axis, as the seed's roll
-criterion asks (by at least 60 deg where the state's dihedral angle is that large, as on most objects). So a
-search for the seed's objective may also try the policy *as if asked* for each such request in its free frames
-and act on whichever the success model rates likeliest: push ``stand_ins`` evenly spaced directions, roll every
-state one roll away. (Spin has none: an asked angle of 30-40 deg may be met by a turn under the seed's 30.) The
-outcome is still judged by the seed's criterion. The policy conditioned on a direction pushes straighter than it
-does unconditioned (0.12: 200 held-out starts, the seed's objective 0.52 by 24 frames alone, 0.69 with 24
-directions added).
+push that moved 5 cm within 15 deg of an asked direction without turning 5 deg met the seed's push criterion too;
+a spin that turned within 10 deg of 40 or 45 deg turned the seed's 30; a roll into a neighbouring resting state
+tips the object about a horizontal axis, as the seed's roll criterion asks (by at least 60 deg where the state's
+dihedral angle is that large, as on most objects). So a search for the seed's objective may also try the policy
+*as if asked* for each such request, in that request's free frames, and act on the option rated likeliest: push
+``stand_ins`` evenly spaced directions, spin 40 and 45 deg each way, roll every state one roll away. The outcome
+is still judged by the seed's criterion. The policies were trained mostly on requests (70-85 % of episodes), and
+the push conditioned on a direction pushes straighter than unconditioned.
 
-The policy is a point-cloud network trained from samples, so it is not invariant under these frames. Its success
-on one start differs with the frame it sees the start in: the spin success model gives the same 35 deg spin of
-one held-out object 0.63 at yaw 0 and 0.02 at yaw 1 rad. Each frame shows the policy a start it could equally
-have met in training (the same object turned, or mirrored), so a skill may evaluate ``n`` of them with its
-success model in one batch and act in the likeliest. The policy and the success model stay as trained.
-
-A frame is a 3x3 map ``B`` applied on top of the goal frame: ``A_frame_world' = B A_frame_world``. Every feature
-block of an observation (position, normal, goal flow) is a vector in the frame, so re-framing is one matrix
-product per block (:func:`reframe`).
+Options of the two kinds are compared on one scale: each option's best frame rating calibrated for its kind
+(``platt`` for a request, ``platt_unparameterised`` for the seed's own observation; the goal-frame success model
+rates the two kinds with different biases: roll's best unconditioned rating is far too high). The chosen score
+gets a calibration of its own, ``platt_stand_ins``.
 
 **Calibration.** The success model was calibrated on starts in one frame; the best of ``m`` ratings is biased
 upwards (it picks the frames the model over-rates as well as those that are good). :class:`FrameSearch` therefore
@@ -103,14 +97,19 @@ def select_frame(seen: SkillObservation, predict, frames: np.ndarray) -> tuple[S
     return reframe(seen, frames[best]), float(p[best])
 
 
+SPIN_STAND_INS = np.radians([40.0, 45.0])  # spin angles whose success (within 10 deg) turned at least 30 deg
+
+
 def stand_in_requests(skill: str, n: int, obj, state: int) -> list[dict]:
     """The requests whose success meets the seed's objective for ``skill`` that a search with ``n`` stand-ins
-    tries (module docstring): push ``n`` directions evenly spaced from -pi (radians), roll each target state one
-    roll away from ``state`` (any ``n > 0``), spin none. Empty for ``n == 0``."""
-    if n <= 0 or skill == "spin":
+    tries (module docstring): push ``n`` directions evenly spaced from -pi (radians); spin ``SPIN_STAND_INS``
+    each way and roll each target state one roll away from ``state``, for any ``n > 0``. Empty for ``n == 0``."""
+    if n <= 0:
         return []
     if skill == "push":
         return [{"direction": -math.pi + 2.0 * math.pi * k / n} for k in range(n)]
+    if skill == "spin":
+        return [{"angle": float(sense * a)} for sense in (1.0, -1.0) for a in SPIN_STAND_INS]
     return [{"target": t} for t in skill_params.roll_targets(obj, state)]
 
 
@@ -123,8 +122,9 @@ class FrameSearch:
     parameter, ``platt_unparameterised`` the same for the seed's objective (which leaves more frames free, so its
     best rating is biased more); ``(1, 0)``: none. ``stand_ins``: for the seed's objective, also try the
     stand-in requests (:func:`stand_in_requests`; push: that many directions, a multiple of ``turns`` so that
-    the set tried is the same from every frame; roll: any number > 0; 0: none). ``info``: how the calibration
-    was made (command, figures).
+    the set tried is the same from every frame; spin, roll: any number > 0; 0: none), and calibrate the chosen
+    score with ``platt_stand_ins`` instead of ``platt_unparameterised``. ``info``: how the calibration was made
+    (command, figures).
     """
 
     turns: int = 1
@@ -133,13 +133,14 @@ class FrameSearch:
     platt_unparameterised: tuple[float, float] = (1.0, 0.0)
     info: dict = field(default_factory=dict, compare=False)
     stand_ins: int = 0
+    platt_stand_ins: tuple[float, float] = (1.0, 0.0)
 
     def __post_init__(self):
         free_frames("spin", None, self.turns, self.mirror)  # checks turns
         if (not isinstance(self.stand_ins, int) or isinstance(self.stand_ins, bool) or self.stand_ins < 0
                 or (self.stand_ins and self.stand_ins % self.turns)):
             raise InputError(f"stand_ins must be 0 or a whole multiple of turns ({self.turns}), got {self.stand_ins!r}")
-        for ab in (self.platt, self.platt_unparameterised):
+        for ab in (self.platt, self.platt_unparameterised, self.platt_stand_ins):
             if len(ab) != 2 or not all(math.isfinite(v) for v in ab):
                 raise InputError(f"a FrameSearch Platt scaling must be two finite numbers, got {ab!r}")
 
@@ -148,48 +149,56 @@ class FrameSearch:
 
     def searches(self, skill: str, params: dict | None) -> bool:
         """Whether a request ``params`` of ``skill`` leaves this search more than one option to rate."""
-        return len(self.frames(skill, params)) > 1 or (params is None and self.stand_ins > 0 and skill != "spin")
+        return len(self.frames(skill, params)) > 1 or (params is None and self.stand_ins > 0)
 
     def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator) -> tuple[SkillObservation, float]:
-        """The observation to act on and its raw rating: ``seen`` (of ``sim``'s current cloud) in the free frame,
-        or for the seed's objective the free frame of the stand-in request, that ``predict`` (observations
-        ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch.
+        """The observation to act on and its score: ``seen`` (of ``sim``'s current cloud) in the free frame, or
+        for the seed's objective with stand-ins the free frame of the stand-in request, that ``predict``
+        (observations ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch.
 
         The returned observation keeps ``seen.params`` (what the outcome is judged by); ``acted_as`` names the
-        stand-in request where one was chosen. The rating is raw: :meth:`calibrate` it with
-        ``seen.params is not None``.
+        stand-in request where one was chosen. The score is the best raw rating, or with stand-ins the best rating
+        calibrated for its kind (module docstring); :meth:`calibrate` it with ``seen.params is not None``.
         """
         frames = self.frames(skill, seen.params)
-        options = [(seen, frames)]
-        if seen.params is None and self.stand_ins:
-            T_world_object = sim.object_pose()
-            state = sim.obj.classify(T_world_object)
-            for request in stand_in_requests(skill, self.stand_ins, sim.obj, state):
-                request = skill_params.check(skill, request, sim.obj, state)
-                asked = observe_cloud(sim.obj, skill, request, seen.points, seen.normals, T_world_object)
-                options.append((asked, self.frames(skill, request)))
-        if len(options) == 1:
+        if seen.params is not None or not self.stand_ins:
             return select_frame(seen, predict, frames)
+        options = [(seen, frames)]
+        T_world_object = sim.object_pose()
+        state = sim.obj.classify(T_world_object)
+        for request in stand_in_requests(skill, self.stand_ins, sim.obj, state):
+            request = skill_params.check(skill, request, sim.obj, state)
+            asked = observe_cloud(sim.obj, skill, request, seen.points, seen.normals, T_world_object)
+            options.append((asked, self.frames(skill, request)))
         p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])))
-        best = int(np.argmax(p))
-        ends = np.cumsum([len(f) for _, f in options])
-        k = int(np.searchsorted(ends, best, side="right"))
+        per_option = np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
+        best = [int(np.argmax(q)) for q in per_option]
+        score = [float(self._platt(q[b], option.params is not None)) for q, b, (option, _) in
+                 zip(per_option, best, options)]
+        k = int(np.argmax(score))
         option, option_frames = options[k]
-        chosen = reframe(option, option_frames[best - (int(ends[k - 1]) if k else 0)])
-        if chosen.params is not None:
-            chosen = replace(chosen, params=seen.params, acted_as=chosen.params)
-        return chosen, float(p.max())
+        chosen = reframe(option, option_frames[best[k]])
+        if k:
+            chosen = replace(chosen, params=None, acted_as=option.params)
+        return chosen, score[k]
 
-    def calibrate(self, p: np.ndarray | float, parameterised: np.ndarray | bool = True) -> np.ndarray:
-        """The calibrated probability of the best ratings ``p`` of requests with (or without) a parameter;
-        ``parameterised`` is one flag for all, or one per rating."""
+    def _platt(self, p: np.ndarray | float, parameterised: np.ndarray | bool) -> np.ndarray:
         (a, b), (a0, b0) = self.platt, self.platt_unparameterised
         par = np.asarray(parameterised, dtype=bool)
         return expit(np.where(par, a, a0) * rating_logit(p) + np.where(par, b, b0))
 
+    def calibrate(self, p: np.ndarray | float, parameterised: np.ndarray | bool = True) -> np.ndarray:
+        """The calibrated probability of the scores ``p`` (:meth:`select`) of requests with (or without) a
+        parameter; ``parameterised`` is one flag for all, or one per score."""
+        if not self.stand_ins:
+            return self._platt(p, parameterised)
+        a, b = self.platt_stand_ins
+        return np.where(parameterised, self._platt(p, True), expit(a * rating_logit(p) + b))
+
     def save(self, path: str | os.PathLike) -> None:
         d = asdict(self)
-        d["platt"], d["platt_unparameterised"] = list(self.platt), list(self.platt_unparameterised)
+        for key in ("platt", "platt_unparameterised", "platt_stand_ins"):
+            d[key] = list(d[key])
         Path(path).write_text(json.dumps(d, indent=2) + "\n")
 
     @classmethod
@@ -199,6 +208,6 @@ class FrameSearch:
             d = json.loads(Path(path).read_text())
             return cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
                        tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}),
-                       int(d.get("stand_ins", 0)))
+                       int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc

@@ -507,7 +507,10 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--mirror", action="store_true", help="also the mirrored frames, where free")
     f.add_argument("--stand-ins", type=int, default=0, metavar="N",
                    help="for the seed's objective, also try the stand-in requests (primitives.frames): push N "
-                        "directions (a multiple of --turns), roll every state one roll away (N > 0); default: none")
+                        "directions (a multiple of --turns), spin 40 and 45 deg each way, roll every state one roll "
+                        "away (N > 0); calibrated on --stand-in-rollouts more rollouts, all for the seed's "
+                        "objective; default: none")
+    f.add_argument("--stand-in-rollouts", type=int, default=1500)
     f.add_argument("--rollouts", type=int, default=2000)
     f.add_argument("--seed", type=int, default=0)
     f.add_argument("--out", default=None, help="folder for frames.json (default: runs/SKILL_frames)")
@@ -623,7 +626,7 @@ def _run_frames(args: argparse.Namespace) -> int:
 
     out = Path(args.out or f"runs/{args.skill}_frames")
     out.mkdir(parents=True, exist_ok=True)
-    search = FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)
+    search = FrameSearch(args.turns, args.mirror)
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
     parts = collect_parallel(collect_frame_search, (model, args.skill), args.rollouts, args.seed, args.workers,
@@ -637,17 +640,27 @@ def _run_frames(args: argparse.Namespace) -> int:
     info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
                 policy=args.policy or "shipped",
                 model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
-                frames_seed_objective=len(search.frames(args.skill, None)), stand_ins=args.stand_ins,
-                minutes=(time.perf_counter() - t0) / 60,
+                frames_seed_objective=len(search.frames(args.skill, None)),
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
-                calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]),
+                calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]))
+    if args.stand_ins:  # the seed's objective alone, acting through the stand-ins as well: their own calibration
+        search = replace(search, stand_ins=args.stand_ins)
+        parts = collect_parallel(collect_frame_search, (model, args.skill), args.stand_in_rollouts, args.seed,
+                                 args.workers, progress=not args.json, search=search, split="train", p_params=0.0)
+        score, seed_data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
+        search = replace(search, platt_stand_ins=fit_frame_calibration(score, seed_data.success))
+        info.update(stand_ins=args.stand_ins, stand_in_rollouts=args.stand_in_rollouts,
+                    stand_in_success_rate=float(seed_data.success.mean()),
+                    stand_in_score=metrics(score, seed_data.success),
+                    stand_in_calibrated=metrics(search.calibrate(score, False), seed_data.success))
+    info.update(minutes=(time.perf_counter() - t0) / 60,
                 command=f"python -m primitives.success frames {args.skill}"
                         f"{f' --policy {args.policy}' if args.policy else ''}"
                         f"{f' --model {args.model}' if args.model else ''} --turns {args.turns}"
-                        f"{' --mirror' if args.mirror else ''}"
-                        f"{f' --stand-ins {args.stand_ins}' if args.stand_ins else ''}"
-                        f" --rollouts {args.rollouts} --seed {args.seed}"
-                        f"{f' --workers {args.workers}' if args.workers > 1 else ''}")
+                        f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts}"
+                        + (f" --stand-ins {args.stand_ins} --stand-in-rollouts {args.stand_in_rollouts}"
+                           if args.stand_ins else "") +
+                        f" --seed {args.seed}{f' --workers {args.workers}' if args.workers > 1 else ''}")
     search = replace(search, info=info)
     search.save(out / "frames.json")
     print((out / "frames.json").read_text())

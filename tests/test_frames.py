@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import affordplan as ap
 from affordplan.errors import InputError
@@ -71,19 +72,24 @@ def test_stand_in_requests_are_requests_whose_success_meets_the_seeds_objective(
     dirs = [r["direction"] for r in stand_in_requests("push", 24, cube, 0)]
     assert len(dirs) == 24 and dirs[0] == pytest.approx(-math.pi) and np.allclose(np.diff(dirs), 2 * math.pi / 24)
     assert stand_in_requests("roll", 1, cube, 0) == [{"target": t} for t in skill_params.roll_targets(cube, 0)]
-    assert stand_in_requests("spin", 24, cube, 0) == [] and stand_in_requests("push", 0, cube, 0) == []
-    # any push that met an asked direction met the seed's push criterion (random planar motions of the cube)
+    spins = [r["angle"] for r in stand_in_requests("spin", 1, cube, 0)]
+    assert np.allclose(np.degrees(spins), [40, 45, -40, -45]) and stand_in_requests("push", 0, cube, 0) == []
+    # any push that met an asked direction, any spin that met 40 or 45 deg, met the seed's criterion too
+    # (random motions of the cube)
     rng = np.random.default_rng(0)
-    met = 0
-    for _ in range(2000):
+    met = {"push": 0, "spin": 0}
+    for _ in range(3000):
         T1 = np.eye(4)
-        T1[:3, :3] = ap.geometry.rot_z(rng.normal(0.0, 0.08))
+        yaw = rng.normal(0.0, 0.06) if rng.random() < 0.5 else rng.uniform(-1.2, 1.2)  # pushes, spins
+        T1[:3, :3] = Rotation.from_rotvec(rng.normal(0.0, 0.03, 3) + [0.0, 0.0, yaw]).as_matrix()
         T1[:2, 3] = rng.uniform(-0.09, 0.09, 2)
-        direction = float(rng.uniform(-math.pi, math.pi))
-        if rewards.success("push", np.eye(4), T1, {"direction": direction}):
-            met += 1
-            assert rewards.success("push", np.eye(4), T1, None)
-    assert met > 20
+        asked = {"push": {"direction": float(rng.uniform(-math.pi, math.pi))},
+                 "spin": {"angle": float(rng.choice(spins))}}
+        for skill in met:
+            if rewards.success(skill, np.eye(4), T1, asked[skill]):
+                met[skill] += 1
+                assert rewards.success(skill, np.eye(4), T1, None)
+    assert min(met.values()) > 20
     with pytest.raises(InputError, match="multiple of turns"):
         FrameSearch(12, True, stand_ins=18)
     with pytest.raises(InputError):
@@ -103,7 +109,7 @@ def test_a_search_for_the_seeds_objective_may_act_as_asked_for_a_stand_in(tmp_pa
         return np.exp(-np.abs(obs - target.obs).sum(axis=(1, 2)))
 
     chosen, p = search.select("push", seen, near_target, sim)
-    assert chosen.params is None and chosen.acted_as == wanted and p == pytest.approx(1.0)
+    assert chosen.params is None and chosen.acted_as == wanted and p == pytest.approx(1.0, abs=1e-5)
     assert np.allclose(chosen.obs, target.obs) and np.allclose(chosen.A_frame_world, target.A_frame_world)
 
     def no_flow(obs):  # rates the seed's own observations (no goal flow) highest
@@ -114,8 +120,18 @@ def test_a_search_for_the_seeds_objective_may_act_as_asked_for_a_stand_in(tmp_pa
     asked = skill_observation(sim, "push", {"direction": 0.3}, 64)  # a request with a parameter has no stand-ins
     kept, _ = search.select("push", asked, near_target, sim)
     assert kept.acted_as is None and kept.params == asked.params
-    search.save(tmp_path / "f.json")
-    assert FrameSearch.load(tmp_path / "f.json").stand_ins == 8
+    # options of both kinds compare on one scale: each best rating calibrated for its kind
+    skewed = FrameSearch(4, True, (1.0, 0.0), (1.0, -4.0), stand_ins=8, platt_stand_ins=(2.0, 0.5))
+
+    def flow_shy(obs):  # 0.9 for the seed's own observation (over-rated for its kind), 0.6 for any request
+        return np.where(np.abs(obs[..., 6:]).sum(axis=(1, 2)) > 0, 0.6, 0.9)
+
+    pick, score = skewed.select("push", seen, flow_shy, sim)
+    assert pick.acted_as is not None and score == pytest.approx(0.6)
+    assert skewed.calibrate(score, False) == pytest.approx(1 / (1 + math.exp(-(2 * math.log(0.6 / 0.4) + 0.5))))
+    assert skewed.calibrate(score, True) == pytest.approx(0.6)
+    skewed.save(tmp_path / "f.json")
+    assert FrameSearch.load(tmp_path / "f.json") == skewed
 
 
 def test_frame_search_calibration_and_files(tmp_path):
