@@ -150,3 +150,21 @@ def test_parallel_collection_splits_the_rollouts_and_worker_0_keeps_the_seed():
     assert not np.array_equal(parts[1].obs, alone.obs[:2])  # worker 1 draws other starts
     with pytest.raises(success.InputError):
         success.collect_parallel(success.collect, (policy, "push"), 5, seed=3, workers=0)
+
+
+def test_frames_command_calibrates_the_stand_ins_on_seed_objective_rollouts(tmp_path, capsys):
+    """``success frames --stand-ins N``: the frames' calibration as before, then rollouts of the seed's objective
+    acting through the stand-ins, on which ``platt_stand_ins`` is fitted; the file records how."""
+    from primitives.frames import FrameSearch
+
+    rc = success.main(["frames", "push", "--turns", "1", "--rollouts", "30", "--stand-ins", "4",
+                       "--stand-in-rollouts", "40", "--seed", "2", "--out", str(tmp_path), "--json"])
+    assert rc == 0
+    search = FrameSearch.load(tmp_path / "frames.json")
+    assert search.stand_ins == 4 and search.platt_stand_ins != (1.0, 0.0)
+    info = search.info
+    assert info["stand_in_rollouts"] == 40 and info["stand_in_calibrated"]["n"] == 40
+    assert 0.0 <= info["stand_in_success_rate"] <= 1.0
+    assert "--stand-ins 4 --stand-in-rollouts 40 --seed 2" in info["command"]
+    # the calibrated mean matches the success rate it was fitted on (Platt scaling with an intercept)
+    assert info["stand_in_calibrated"]["mean_prediction"] == pytest.approx(info["stand_in_success_rate"], abs=0.02)
