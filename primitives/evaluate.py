@@ -146,14 +146,14 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
     for key in tqdm(plan, desc=f"evaluate {primitive}", disable=not progress, unit="trial", mininterval=2.0):
         obs = env.reset(object_key=key)
         if predict is not None:
-            searched = frame_search.searches(primitive, env.seen.params)
-            stand_ins = env.seen.params is None and frame_search.stand_ins > 0
+            params = env.seen.params
             env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim)
             obs = env.seen.obs
-            if searched:
-                result.frames = (f"best of {len(frame_search.frames(primitive, env.seen.params))} free frames"
-                                 + (" and the stand-in requests' frames" if stand_ins else ""))
-                rating = float(frame_search.calibrate(rating, env.seen.params is not None))
+            if frame_search.searches(primitive, params):
+                result.frames = (f"best of {len(frame_search.frames(primitive, params))} free frames"
+                                 + (" and the stand-in requests' frames" if frame_search.tries_stand_ins(params)
+                                    else ""))
+                rating = float(frame_search.calibrate(rating, params is not None))
             result.predicted.append(rating)
             result.acted_as.append(env.seen.acted_as)
         idx, motion, _ = greedy_action(model, obs)

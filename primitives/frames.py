@@ -158,9 +158,13 @@ class FrameSearch:
     def frames(self, skill: str, params: dict | None) -> np.ndarray:
         return free_frames(skill, params, self.turns, bool(self.mirror))
 
+    def tries_stand_ins(self, params: dict | None) -> bool:
+        """Whether this search tries stand-in requests for ``params`` (the seed's objective, with ``stand_ins``)."""
+        return params is None and self.stand_ins > 0
+
     def searches(self, skill: str, params: dict | None) -> bool:
         """Whether a request ``params`` of ``skill`` leaves this search more than one option to rate."""
-        return len(self.frames(skill, params)) > 1 or (params is None and self.stand_ins > 0)
+        return len(self.frames(skill, params)) > 1 or self.tries_stand_ins(params)
 
     def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator) -> tuple[SkillObservation, float]:
         """The observation to act on and its score: ``seen`` (of ``sim``'s current cloud) in the free frame, or
@@ -172,7 +176,7 @@ class FrameSearch:
         calibrated for its kind (module docstring); :meth:`calibrate` it with ``seen.params is not None``.
         """
         frames = self.frames(skill, seen.params)
-        if seen.params is not None or not self.stand_ins:
+        if not self.tries_stand_ins(seen.params):
             return select_frame(seen, predict, frames)
         options = [(seen, frames)]
         T_world_object = sim.object_pose()

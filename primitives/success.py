@@ -555,6 +555,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--workers must be a positive integer, got {args.workers}")
     if getattr(args, "members", 1) < 1:
         parser.error(f"--members must be a positive integer, got {args.members}")
+    if getattr(args, "stand_ins", 0) and args.stand_in_rollouts < 1:
+        parser.error(f"--stand-in-rollouts must be a positive integer, got {args.stand_in_rollouts}")
     torch.set_num_threads(1)
     try:
         return _run(args)
@@ -626,6 +628,7 @@ def _run_frames(args: argparse.Namespace) -> int:
 
     out = Path(args.out or f"runs/{args.skill}_frames")
     out.mkdir(parents=True, exist_ok=True)
+    FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)  # checks --turns / --stand-ins before any rollout
     search = FrameSearch(args.turns, args.mirror)
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
