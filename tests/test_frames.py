@@ -288,3 +288,23 @@ def test_evaluation_with_stand_ins_counts_the_trials_acted_as_one():
     asked = evaluate(model, "push", ("pill_bottle",), trials=2, seed=3, progress=False, p_params=1.0,
                      frame_search=search).as_dict()
     assert "stand_in_share" not in asked and asked["frames"] == "best of 2 free frames"  # a direction: mirror only
+
+
+def test_the_shipped_spin_acting_as_a_stand_in_turns_the_seeds_thirty_degrees():
+    from primitives import load_skill
+
+    skill = load_skill("spin")
+    assert skill.frame_search.tries_stand_ins(None) and not skill.frame_search.tries_stand_ins({"angle": 0.5})
+
+    def fresh():
+        sim = ap.Simulator(ap.load_object("mug"), seed=2)
+        sim.reset()
+        return sim
+
+    acted_as = skill.observe(fresh(), None).acted_as
+    assert acted_as is not None and math.degrees(abs(acted_as["angle"])) in (pytest.approx(40), pytest.approx(45))
+    out = skill.execute(fresh(), None)
+    m = rewards.motion(out.pose_before, out.pose_after)
+    assert out.success and m.theta_deg >= 30 and m.wz >= math.cos(math.radians(45))
+    assert math.copysign(1.0, rewards.signed_turn_deg(m)) == math.copysign(1.0, acted_as["angle"])  # the asked sense
+    assert m.p_xy < 0.05
