@@ -126,3 +126,28 @@ def test_a_contact_under_the_mugs_handle_fails_its_approach_without_lifting_the_
     assert out.valid and not out.approach_ok
     assert np.linalg.norm(out.pose_after[:3, 3] - T0[:3, 3]) < 0.005  # untouched: still where it was
     assert mug.classify(out.pose_after) == 0
+
+
+STRETCHED = (0.179, 1.0611, 0.0125, -0.4512, -0.011, 1.5301, 0.7874)  # the arm after a push to x = 0.71 m (plan bench)
+
+
+def test_an_arm_stretched_by_a_far_push_is_homed_instead_of_refusing_what_it_reaches(cube):
+    sim = ap.Simulator(cube, pusher="arm")
+    T0 = sim.reset(resting_state=0, xy=(0.68, 0.0), yaw=0.0)
+    contact, far_normal = T0[:3, 3] + np.array([0.05, 0.0, 0.0]), np.array([1.0, 0.0, 0.0])
+    _, touch, pre = sim._approach_points(contact, far_normal)
+    sim._pusher.set_q(STRETCHED)
+    with pytest.raises(ReachabilityError):  # IK seeded with the stretched arm stalls short of the far face
+        sim._ik.check_reachable([pre, touch], sim._pusher.q)
+    out = sim.execute(contact, (-2.0 / 3.0, 0.0, 0.0), normal=far_normal)  # homed, then pushed towards the base
+    m = rewards.motion(out.pose_before, out.pose_after)
+    assert out.approach_ok and out.valid
+    assert -0.09 <= m.p[0] <= -0.04 and abs(m.p[1]) < 0.01 and m.theta_deg < 5.0
+
+    far = ap.Simulator(cube, pusher="arm")
+    T1 = far.reset(resting_state=0, xy=(0.72, 0.0), yaw=0.0)  # its far face is beyond the reach from HOME too
+    far._pusher.set_q(STRETCHED)
+    steps = far.physics_steps
+    with pytest.raises(ReachabilityError, match="cannot reach"):
+        far.execute(T1[:3, 3] + np.array([0.05, 0.0, 0.0]), (-2.0 / 3.0, 0.0, 0.0), normal=far_normal)
+    assert far.physics_steps == steps and np.array_equal(far.object_pose(), T1)

@@ -119,12 +119,16 @@ class ArmPusher:
         return self.data.qpos[self._qpos].copy()
 
     def home(self) -> None:
+        self.set_q(arm.HOME)
+
+    def set_q(self, q) -> None:
+        """Place the arm at rest at joint configuration ``q`` (7, radians), its fingertip target where the tip is."""
         d = self.data
-        d.qpos[self._qpos] = arm.HOME
+        d.qpos[self._qpos] = q
         d.qvel[self._qvel] = 0.0
-        d.act[self._act] = arm.HOME
+        d.act[self._act] = q
         d.ctrl[self._ctrl] = 0.0
-        self.ik.set_q(np.array(arm.HOME))
+        self.ik.set_q(np.array(q, dtype=float))
         mujoco.mj_forward(self.model, d)
         self._target = self.tip()
         self._offset = np.zeros(3)
