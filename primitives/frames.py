@@ -26,7 +26,7 @@ dihedral angle is that large, as on most objects). So a search for the seed's ob
 *as if asked* for each such request, in that request's free frames, and act on the option rated likeliest: push
 ``stand_ins`` evenly spaced directions, spin 40 and 45 deg each way, roll every state one roll away. The outcome
 is still judged by the seed's criterion. The policies were trained mostly on requests (70-85 % of episodes), and
-the push conditioned on a direction pushes straighter than unconditioned. On 200 held-out starts (0.13): push
+the push conditioned on a direction pushes straighter than unconditioned. On 200 held-out starts: push
 0.52 -> 0.685, roll 0.80 -> 0.855 (0.13), spin 0.81 -> 0.85 (0.14).
 
 Options of the two kinds are compared on one scale: each option's best frame rating calibrated for its kind
