@@ -626,10 +626,10 @@ def _run_frames(args: argparse.Namespace) -> int:
     from primitives.evaluate import load_policy
     from primitives.frames import FrameSearch
 
+    asked = FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)  # checks --turns / --stand-ins first
+    search = replace(asked, stand_ins=0)  # the first pass calibrates the frames alone
     out = Path(args.out or f"runs/{args.skill}_frames")
     out.mkdir(parents=True, exist_ok=True)
-    FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)  # checks --turns / --stand-ins before any rollout
-    search = FrameSearch(args.turns, args.mirror)
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
     parts = collect_parallel(collect_frame_search, (model, args.skill), args.rollouts, args.seed, args.workers,
@@ -646,8 +646,8 @@ def _run_frames(args: argparse.Namespace) -> int:
                 frames_seed_objective=len(search.frames(args.skill, None)),
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
                 calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]))
-    if args.stand_ins:  # the seed's objective alone, acting through the stand-ins as well: their own calibration
-        search = replace(search, stand_ins=args.stand_ins)
+    if asked.stand_ins:  # the seed's objective alone, acting through the stand-ins as well: their own calibration
+        search = replace(search, stand_ins=asked.stand_ins)
         parts = collect_parallel(collect_frame_search, (model, args.skill), args.stand_in_rollouts, args.seed,
                                  args.workers, progress=not args.json, search=search, split="train", p_params=0.0)
         score, seed_data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
