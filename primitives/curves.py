@@ -16,11 +16,17 @@ def read_log(run: str | Path) -> dict[str, list[float]]:
     return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
 
 
+def thousands(x: float) -> str:
+    """A step count as a tick label in thousands: ``120000 -> "120k"``, ``2500 -> "2.5k"``, ``0 -> "0"``."""
+    return f"{x / 1000:g}k" if x else "0"
+
+
 def plot_curves(runs: list[str | Path], out: str | Path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
     for run in runs:
@@ -31,6 +37,8 @@ def plot_curves(runs: list[str | Path], out: str | Path) -> None:
         axes[0].plot(log["step"], log["success_recent"], label=label)
         axes[1].plot(log["step"], log["reward_recent"], label=label)
         axes[2].plot(log["minutes"], log["rss_mb_total"], label=label)
+    for ax in axes[:2]:  # six-digit step counts run into each other as tick labels
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda x, _: thousands(x)))
     axes[0].set(xlabel="primitives executed", ylabel="success (last 500, exploring)", ylim=(0, 1),
                 title="training success")
     axes[1].set(xlabel="primitives executed", ylabel="reward = -L (last 500)", title="training reward")
