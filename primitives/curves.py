@@ -9,9 +9,15 @@ import argparse
 import csv
 from pathlib import Path
 
+from affordplan.errors import InputError
+
 
 def read_log(run: str | Path) -> dict[str, list[float]]:
-    with open(Path(run) / "log.csv", newline="") as f:
+    """The columns of ``run/log.csv`` as lists (empty for a log with no rows yet)."""
+    path = Path(run) / "log.csv"
+    if not path.is_file():
+        raise InputError(f"{run} is not a training run folder: it has no log.csv")
+    with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
 
@@ -58,7 +64,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("runs", nargs="+", help="run folders (each with a log.csv)")
     p.add_argument("--out", default="curves.png")
     args = p.parse_args(argv)
-    plot_curves(args.runs, args.out)
+    try:
+        plot_curves(args.runs, args.out)
+    except InputError as exc:
+        p.error(str(exc))
     print(f"wrote {args.out}")
     return 0
 

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import pytest
+
+from affordplan.errors import InputError
+from primitives import curves
 from primitives.curves import plot_curves, read_log, thousands
 
 HEADER = "step,updates,minutes,success_recent,reward_recent,critic_loss,actor_loss,invalid,steps_per_s,rss_mb_total\n"
@@ -26,3 +30,12 @@ def test_plot_curves_writes_a_png(tmp_path):
     out = tmp_path / "curves.png"
     plot_curves([run, empty], out)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_folder_without_a_log_is_refused_clearly(tmp_path, capsys):
+    with pytest.raises(InputError, match="no log.csv"):
+        read_log(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        curves.main([str(tmp_path), "--out", str(tmp_path / "c.png")])
+    assert exit_info.value.code == 2 and "no log.csv" in capsys.readouterr().err
+    assert not (tmp_path / "c.png").exists()
