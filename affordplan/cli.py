@@ -139,7 +139,7 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
     log = (lambda text: print(text, file=sys.stderr, flush=True)) if args.log else None
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
                         max_primitives=args.max_primitives, progress=not args.json and not args.log,
-                        only=args.task, log=log)
+                        only=args.task, log=log, weights_dir=args.weights_dir)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -387,7 +387,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "each planner."),
         epilog="examples:\n  affordplan bench plan --tasks 50 --sim arm --seed 0\n"
                "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json\n"
-               "  affordplan bench plan --seed 3 --task 22 42 --planner affordplan --log   # why they failed",
+               "  affordplan bench plan --seed 3 --task 22 42 --planner affordplan --log   # why they failed\n"
+               "  affordplan bench plan --planner affordplan --weights-dir primitives/weights/candidates/push_60",
         formatter_class=_formatter,
     )
     bp.add_argument("--tasks", type=_positive_int, default=50, help="number of tasks (default: %(default)s)")
@@ -400,6 +401,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="run only these tasks of the seed's draw (the same tasks as in the whole run)")
     bp.add_argument("--log", action="store_true",
                     help="print each task's first plan and step-by-step execution log (to stderr)")
+    bp.add_argument("--weights-dir", default=None, metavar="DIR",
+                    help="run the skills from this folder's files (laid out like primitives/weights/, e.g. "
+                         "primitives/weights/candidates/push_60) instead of the shipped ones; a skill without "
+                         "files there stays shipped")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     _register_robustness(bench_sub)

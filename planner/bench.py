@@ -14,6 +14,7 @@ right resting state, within ``max_primitives``.
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -30,7 +31,8 @@ from affordplan.objects.model import ObjectModel, random_object
 from affordplan.world import Box, Workspace
 from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, inflated_footprints, make_checkers
-from planner.predict import Predictor
+from planner.predict import SKILLS, Predictor
+from primitives.skills import load_skill
 
 # seed S's tasks take test objects 1000 S, 1000 S + 1, ... (until release 0.7: objects 0-49 for every seed)
 OBJECTS_PER_SEED = 1000
@@ -193,8 +195,13 @@ def _describe(task: Task) -> str:
 
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
-               only: Sequence[int] | None = None, log: Callable[[str], None] | None = None) -> BenchReport:
+               only: Sequence[int] | None = None, log: Callable[[str], None] | None = None,
+               weights_dir: str | os.PathLike | None = None) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring).
+
+    ``weights_dir``: run the skills from this folder's files instead of the shipped ones
+    (:func:`primitives.skills.load_skill`; a skill without files there stays shipped), e.g. to bench a
+    candidate set of weights before shipping it.
 
     ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
     run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
@@ -206,6 +213,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     wanted = range(n_tasks) if only is None else sorted(set(only))
     if not wanted or not all(0 <= i < OBJECTS_PER_SEED for i in wanted):
         raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
+    skills = None if weights_dir is None else {name: load_skill(name, weights_dir=weights_dir) for name in SKILLS}
     rng = np.random.default_rng(seed)
     report = BenchReport()
     bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")
@@ -213,7 +221,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
         task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)  # drawn in order: task i is the same in any run
         if i not in wanted:
             continue
-        predictor = Predictor(obj, seed=seed)
+        predictor = Predictor(obj, skills=skills, seed=seed)
         for name in planners:
             if log is not None:
                 log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")

@@ -5,11 +5,11 @@ trained skills (``load_skill``)."""
 from primitives import rewards
 
 
-def load_skill(name: str, weights=None, success_weights=None, frame_search=True, searched=True):
+def load_skill(name: str, weights=None, success_weights=None, frame_search=True, searched=True, weights_dir=None):
     """The ``push``, ``roll`` or ``spin`` skill (see :func:`primitives.skills.load_skill`)."""
     from primitives.skills import load_skill as _load
 
-    return _load(name, weights, success_weights, frame_search, searched)
+    return _load(name, weights, success_weights, frame_search, searched, weights_dir)
 
 
 __all__ = ["load_skill", "rewards"]

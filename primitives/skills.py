@@ -27,6 +27,7 @@ decision and the net, ~2 ms). The skill still *acts* through the frame search.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -160,15 +161,17 @@ class Skill:
         return self.frame_search.calibrate(p.reshape(*obs.shape[:-2], len(frames)).max(axis=-1), parameterised)
 
 
-def shipped_frame_search(name: str) -> FrameSearch | None:
-    """The frame search shipped beside a skill's weights (``weights/{name}_frames.json``), if any."""
-    path = WEIGHTS_DIR / f"{name}_frames.json"
+def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None) -> FrameSearch | None:
+    """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
+    package's ``weights/``), if any."""
+    path = Path(weights_dir or WEIGHTS_DIR) / f"{name}_frames.json"
     return FrameSearch.load(path) if path.exists() else None
 
 
 def load_skill(name: str, weights: str | os.PathLike | None = None,
                success_weights: str | os.PathLike | None = None,
-               frame_search: FrameSearch | bool = True, searched: bool = True) -> Skill:
+               frame_search: FrameSearch | bool = True, searched: bool = True,
+               weights_dir: str | os.PathLike | None = None) -> Skill:
     """The ``push``, ``roll`` or ``spin`` skill, from the shipped weights or given files.
 
     ``frame_search`` (:mod:`primitives.frames`): ``True``, the one shipped beside the weights where there is one
@@ -177,18 +180,36 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
     ``searched``: with the shipped weights and frame search (``frame_search=True``), rate requests with the
     searched success model shipped beside them (``weights/{name}_success_searched.pt``) where there is one;
     ``False``: rate them through the frame search.
+    ``weights_dir``: a folder laid out like the package's ``weights/`` (``{name}.pt`` and ``{name}_success.pt``,
+    optionally ``{name}_frames.json`` and ``{name}_success_searched.pt``, all fitted together), whose files then
+    stand in for the shipped ones, e.g. a candidate set under ``weights/candidates/``. A folder without
+    ``{name}.pt`` leaves that skill on the shipped files. Not combined with ``weights`` or ``success_weights``.
     """
     if name not in PRIMITIVES:
         raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
+    directory = WEIGHTS_DIR
+    if weights_dir is not None:
+        if weights is not None or success_weights is not None:
+            raise InputError("give weights_dir, or weights and success_weights, not both")
+        folder = Path(weights_dir)
+        if not folder.is_dir():
+            raise InputError(f"weights_dir {str(folder)!r} is not a folder")
+        if (folder / f"{name}.pt").exists():
+            if not (folder / f"{name}_success.pt").exists():
+                raise InputError(f"{folder / (name + '.pt')} has no success model beside it "
+                                 f"({name}_success.pt, fitted to that policy)")
+            directory = folder
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
     shipped = frame_search is True and weights is None and success_weights is None
+    if directory != WEIGHTS_DIR:  # the folder's files, used together as the shipped ones are
+        weights, success_weights = directory / f"{name}.pt", directory / f"{name}_success.pt"
     if frame_search is True:
-        frame_search = shipped_frame_search(name) if shipped else None
+        frame_search = shipped_frame_search(name, directory) if shipped else None
     elif frame_search is False:
         frame_search = None
     elif not isinstance(frame_search, FrameSearch):
         raise InputError(f"frame_search must be True, False or a FrameSearch, got {frame_search!r}")
-    searched_path = WEIGHTS_DIR / f"{name}_success_searched.pt"  # trained on the shipped skill's outcomes
+    searched_path = directory / f"{name}_success_searched.pt"  # trained on that skill's frame-searched outcomes
     searched_weights = searched_path if searched and shipped and searched_path.exists() else None
     return Skill(name, load_policy(weights, name), success_weights=success_weights, frame_search=frame_search,
                  searched_weights=searched_weights)

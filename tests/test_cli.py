@@ -180,6 +180,13 @@ def test_bench_plan_task_indices_must_not_be_negative(capsys):
     assert info.value.code == 2 and "expected a non-negative integer, got -1" in capsys.readouterr().err
 
 
+def test_bench_plan_refuses_a_weights_folder_that_is_not_there_before_any_task(capsys, tmp_path):
+    assert cli.main(["bench", "plan", "--tasks", "1", "--planner", "affordplan", "--json",
+                     "--weights-dir", str(tmp_path / "nowhere")]) == 2
+    captured = capsys.readouterr()
+    assert "is not a folder" in captured.err and captured.out == ""
+
+
 def test_cli_reports_library_errors_cleanly(capsys, tmp_path):
     assert cli.main(["render", "teapot"]) == 2
     assert "unknown object 'teapot'" in capsys.readouterr().err

@@ -89,3 +89,50 @@ def test_the_arm_sees_a_wall_over_a_pre_contact_point(cube):
     assert not sim.approach_clear(side, np.array([0.0, -1.0, 0.0]))  # pre-contact point over the wall
     assert sim.approach_clear(np.array([0.45, 0.0, 0.05]), np.array([-1.0, 0.0, 0.0]))
     assert ap.Simulator(cube, obstacles=(wall,), seed=0).approach_clear(side, np.array([0.0, -1.0, 0.0]))
+
+
+# ----------------------------------------------------------------------------- a folder of weights
+def _copy_skill_files(name: str, folder, files=("{}.pt", "{}_success.pt", "{}_frames.json", "{}_success_searched.pt")):
+    import shutil
+
+    for pattern in files:
+        shutil.copyfile(skills_module.WEIGHTS_DIR / pattern.format(name), folder / pattern.format(name))
+
+
+def test_a_weights_folder_stands_in_for_the_shipped_files_and_rates_and_acts_the_same(tmp_path, cube):
+    _copy_skill_files("push", tmp_path)
+    torch = pytest.importorskip("torch")
+    shipped, folder = load_skill("push"), load_skill("push", weights_dir=tmp_path)
+    assert folder.frame_search == shipped.frame_search  # the folder's frames.json, loaded
+    assert folder._searched_weights == tmp_path / "push_success_searched.pt"
+    for a, b in zip(shipped.model.state_dict().values(), folder.model.state_dict().values(), strict=True):
+        assert torch.equal(a, b)
+    params = {"direction": 0.7}
+    answers = []
+    for skill in (shipped, folder):  # each on its own simulator in the same state (a query draws a cloud)
+        sim = ap.Simulator(cube, seed=3)
+        sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+        answers.append((skill.success_probability(sim, params), *skill.act(sim, params)))
+    (p1, c1, m1), (p2, c2, m2) = answers
+    assert p1 == pytest.approx(p2)
+    np.testing.assert_allclose(c1, c2)
+    np.testing.assert_allclose(m1, m2)
+
+
+def test_a_weights_folder_without_a_skill_leaves_it_shipped(tmp_path):
+    _copy_skill_files("push", tmp_path)
+    spin = load_skill("spin", weights_dir=tmp_path)
+    assert spin._searched_weights == skills_module.WEIGHTS_DIR / "spin_success_searched.pt"
+    assert spin.frame_search == load_skill("spin").frame_search
+
+
+def test_a_weights_folder_is_refused_without_a_success_model_or_beside_other_files(tmp_path):
+    from affordplan.errors import InputError
+
+    _copy_skill_files("push", tmp_path, files=("{}.pt",))
+    with pytest.raises(InputError, match="no success model beside it"):
+        load_skill("push", weights_dir=tmp_path)
+    with pytest.raises(InputError, match="not a folder"):
+        load_skill("push", weights_dir=tmp_path / "missing")
+    with pytest.raises(InputError, match="not both"):
+        load_skill("push", weights=tmp_path / "push.pt", weights_dir=tmp_path)
