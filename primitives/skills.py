@@ -187,22 +187,20 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
     """
     if name not in PRIMITIVES:
         raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
+    if weights_dir is not None and (weights is not None or success_weights is not None):
+        raise InputError("give weights_dir, or weights and success_weights, not both")
+    shipped = frame_search is True and weights is None and success_weights is None
     directory = WEIGHTS_DIR
     if weights_dir is not None:
-        if weights is not None or success_weights is not None:
-            raise InputError("give weights_dir, or weights and success_weights, not both")
         folder = Path(weights_dir)
         if not folder.is_dir():
             raise InputError(f"weights_dir {str(folder)!r} is not a folder")
-        if (folder / f"{name}.pt").exists():
-            if not (folder / f"{name}_success.pt").exists():
-                raise InputError(f"{folder / (name + '.pt')} has no success model beside it "
-                                 f"({name}_success.pt, fitted to that policy)")
+        if (folder / f"{name}.pt").exists():  # the folder's files, used together as the shipped ones are
+            weights, success_weights = folder / f"{name}.pt", folder / f"{name}_success.pt"
+            if not success_weights.exists():
+                raise InputError(f"{weights} has no success model beside it ({name}_success.pt, fitted to that policy)")
             directory = folder
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
-    shipped = frame_search is True and weights is None and success_weights is None
-    if directory != WEIGHTS_DIR:  # the folder's files, used together as the shipped ones are
-        weights, success_weights = directory / f"{name}.pt", directory / f"{name}_success.pt"
     if frame_search is True:
         frame_search = shipped_frame_search(name, directory) if shipped else None
     elif frame_search is False:

@@ -1,12 +1,15 @@
-"""Skills with the arm: a contact it cannot reach is masked out and the policy's next best one is tried."""
+"""Skills with the arm (a contact it cannot reach is masked out and the policy's next best one is tried), and skills
+loaded from a folder of weights."""
 
 from __future__ import annotations
+
+import shutil
 
 import numpy as np
 import pytest
 
 import affordplan as ap
-from affordplan.errors import ReachabilityError
+from affordplan.errors import InputError, ReachabilityError
 from primitives import load_skill
 from primitives import skills as skills_module
 
@@ -93,20 +96,17 @@ def test_the_arm_sees_a_wall_over_a_pre_contact_point(cube):
 
 # ----------------------------------------------------------------------------- a folder of weights
 def _copy_skill_files(name: str, folder, files=("{}.pt", "{}_success.pt", "{}_frames.json", "{}_success_searched.pt")):
-    import shutil
-
     for pattern in files:
         shutil.copyfile(skills_module.WEIGHTS_DIR / pattern.format(name), folder / pattern.format(name))
 
 
 def test_a_weights_folder_stands_in_for_the_shipped_files_and_rates_and_acts_the_same(tmp_path, cube):
     _copy_skill_files("push", tmp_path)
-    torch = pytest.importorskip("torch")
     shipped, folder = load_skill("push"), load_skill("push", weights_dir=tmp_path)
     assert folder.frame_search == shipped.frame_search  # the folder's frames.json, loaded
     assert folder._searched_weights == tmp_path / "push_success_searched.pt"
     for a, b in zip(shipped.model.state_dict().values(), folder.model.state_dict().values(), strict=True):
-        assert torch.equal(a, b)
+        assert np.array_equal(a.numpy(), b.numpy())
     params = {"direction": 0.7}
     answers = []
     for skill in (shipped, folder):  # each on its own simulator in the same state (a query draws a cloud)
@@ -127,8 +127,6 @@ def test_a_weights_folder_without_a_skill_leaves_it_shipped(tmp_path):
 
 
 def test_a_weights_folder_is_refused_without_a_success_model_or_beside_other_files(tmp_path):
-    from affordplan.errors import InputError
-
     _copy_skill_files("push", tmp_path, files=("{}.pt",))
     with pytest.raises(InputError, match="no success model beside it"):
         load_skill("push", weights_dir=tmp_path)
