@@ -4,9 +4,10 @@
 
 1. **Route.** The likeliest chain of rolls from the start's resting state to the goal's
    (:class:`planner.graph.RestingStateGraph`, edges ``-log P(roll)`` from the roll skill's success model).
-2. **Roll spots.** Each roll happens where it has room: the nearest place (to the object, then to the
-   goal) where a disc covering the object before and after the roll, grown by ``roll_margin`` (the
-   displacement a roll causes), is clear of obstacles.
+2. **Roll spots.** Each roll happens where it has room: a disc covering the object before and after the
+   roll, grown by ``roll_margin`` (the displacement a roll causes), clear of obstacles: the nearest such place
+   to the object (travel after rolling) or to the goal (travel before rolling, in the states the pushes are
+   rated likelier in). Each placement is planned and the likeliest plan kept.
 3. **Paths.** Between rolls, and from the last one to the goal, OMPL plans the footprint's SE(2) path
    (:mod:`planner.motion`); the footprint of each resting state is inflated by ``clearance`` (the room
    the fingertip needs beside the object).
@@ -265,7 +266,13 @@ class Planner:
 
     # --------------------------------------------------------------------- plan
     def plan(self, T_start: np.ndarray, goal: Goal) -> Plan:
-        """A plan from the settled pose ``T_start`` to ``goal``; raises PlanningError / GoalError."""
+        """A plan from the settled pose ``T_start`` to ``goal``; raises PlanningError / GoalError.
+
+        Where the route rolls, the placements of its rolls are planned and the likeliest plan kept
+        (:meth:`_placements`): rolling where the object is and travelling in the later states, or travelling
+        first and rolling near the goal (rated with one more push in the goal's state, for the shift a roll
+        causes).
+        """
         t0 = time.perf_counter()
         deadline = t0 + self.time_limit
         state, x, y, yaw = self.obj.planar_pose(T_start)
@@ -274,11 +281,36 @@ class Planner:
         route = self.graph.route(state, goal_state)
         if turn:
             route = self._route_to_turn(route, yaw, goal)
+        best, error = None, None
+        for late_from in self._placements(route):
+            try:
+                calls, paths = self._route_calls(route, (x, y, yaw), goal, goal_state, turn, deadline, late_from)
+            except PlanningError as exc:  # no room or no path this way: another placement may have one
+                error = error or exc
+                continue
+            steps = self._steps(state, (x, y, yaw), calls)
+            p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
+            rolled_late = late_from < len(route) - 1
+            score = p * self._settle_push_probability(goal_state, goal, calls[-1][3]) if rolled_late else p
+            if best is None or score > best[0]:
+                best = (score, steps, p, paths)
+        if best is None:
+            raise error
+        _, steps, p, paths = best
+        self._calls += 1
+        return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
+                    goal=goal, start_pose=np.array(T_start), planner=self)
+
+    def _route_calls(self, route: list[int], start: tuple[float, float, float], goal: Goal, goal_state: int,
+                     turn: bool, deadline: float, late_from: int) -> tuple[list, list[tuple[int, np.ndarray]]]:
+        """The calls (``(state, skill, params, pose after)``) and paths that take the object from ``start``
+        (x, y, yaw) along ``route`` to ``goal``; its rolls ``late_from`` on are made near the goal, those before
+        where the object is."""
         calls: list[tuple[int, str, dict, tuple[float, float, float]]] = []
         paths: list[tuple[int, np.ndarray]] = []
-        cur = (x, y, yaw)
+        cur = start
         for k, (a, b) in enumerate(zip(route, route[1:])):
-            spot = self._roll_spot(a, b, cur, goal)
+            spot = self._roll_spot(a, b, cur, goal, late=k >= late_from)
             want_yaw = cur[2]
             last_roll = k == len(route) - 2
             if turn and last_roll and self._turns_better(a, goal_state):
@@ -294,16 +326,31 @@ class Planner:
             _, ax, ay, ayaw = self.obj.planar_pose(T_after)
             calls.append((a, "roll", {"target": b}, (ax, ay, ayaw)))
             cur = (ax, ay, ayaw)
-        goal_yaw = goal.yaw_near(self.obj, goal_state, cur[2]) if turn else self._free_yaw(goal_state, goal.xy, cur[2])
-        segment_paths, segment = self._segment(goal_state, cur, (*goal.xy, goal_yaw), deadline,
+        # a roll near the goal that leaves the object within half the goal's tolerance is not followed by a
+        # stride to the goal's centre (two short pushes in a V, each likelier to overshoot than to help)
+        late = late_from < len(route) - 1
+        end = cur[:2] if late and math.dist(cur[:2], goal.xy) <= 0.5 * goal.xy_tol else goal.xy
+        goal_yaw = goal.yaw_near(self.obj, goal_state, cur[2]) if turn else self._free_yaw(goal_state, end, cur[2])
+        segment_paths, segment = self._segment(goal_state, cur, (*end, goal_yaw), deadline,
                                                goal_yaw if turn else None)
         paths += [(goal_state, path) for path in segment_paths]
         calls += [(goal_state, *c) for c in segment]
-        steps = self._steps(state, (x, y, yaw), calls)
-        p = float(np.prod([s.p_success for s in steps])) if steps else 1.0
-        self._calls += 1
-        return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
-                    goal=goal, start_pose=np.array(T_start), planner=self)
+        return calls, paths
+
+    @staticmethod
+    def _placements(route: list[int]) -> list[int]:
+        """Roll placements to plan for ``route``, as ``late_from``: its rolls from that index on are made near the
+        goal, the earlier ones where the object is. Every placement of up to two rolls (travel before, between
+        or after them), else all here or all near the goal; all here first, so that it wins ties."""
+        n = len(route) - 1
+        return list(range(n, -1, -1)) if n <= 2 else [n, 0]
+
+    def _settle_push_probability(self, state: int, goal: Goal, at: tuple[float, float, float]) -> float:
+        """Predicted success of a push in ``state`` at the goal (yaw of ``at``), the mean over 8 directions: what
+        a plan that rolls near the goal is rated with, for the push that puts right the shift the roll causes."""
+        T = state_pose(self.obj, state, goal.xy[0], goal.xy[1], at[2])
+        pushes = [("push", {"direction": float(a)}, T) for a in np.linspace(-math.pi, math.pi, 8, endpoint=False)]
+        return float(np.mean(self.predictor.p_success_many(pushes)))
 
     def _segment(self, state: int, start, end, deadline: float,
                  final_yaw: float | None = None) -> tuple[list[np.ndarray], list[chain.Call]]:
@@ -553,8 +600,9 @@ class Planner:
         _, _, px, py = min(found)
         return px, py
 
-    def _roll_spot(self, a: int, b: int, cur, goal: Goal) -> tuple[float, float]:
-        """Nearest place where a roll from state ``a`` to ``b`` has room.
+    def _roll_spot(self, a: int, b: int, cur, goal: Goal, late: bool = False) -> tuple[float, float]:
+        """Nearest place, to the object (``cur``: x, y, yaw) or with ``late`` to the goal, where a roll from
+        state ``a`` to ``b`` has room.
 
         The room is a disc around the object, clear of obstacles. A disc inside the workspace is preferred
         (rolls near its edge drift out of it); where no such spot exists (a big object among obstacles),
@@ -564,8 +612,9 @@ class Planner:
         disc = _disc(r, 16)
         ws = self.workspace
         grown = Workspace(x=(ws.x[0] - r, ws.x[1] + r), y=(ws.y[0] - r, ws.y[1] + r))
+        near = (goal.xy[0], goal.xy[1], cur[2]) if late else cur
         for room in (FootprintChecker(disc, self.obstacles, ws), FootprintChecker(disc, self.obstacles, grown)):
-            spot = self._nearest_room(room, a, cur, goal)
+            spot = self._nearest_room(room, a, near, goal)
             if spot is not None:
                 return spot
         raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")

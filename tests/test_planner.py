@@ -339,15 +339,15 @@ def test_failure_memory_counts_calls_that_did_not_move_the_object_as_asked():
     assert not made_progress(cube, "push", {"direction": 0.0}, T0, rolled)  # tipped over: not a push's doing
 
 
-class SpinsBadlyIn(StubPredictor):
-    """Rates spins in one resting state at 0.05, every other call at 0.8."""
+class RatesBadlyIn(StubPredictor):
+    """Rates one skill's calls in one resting state at 0.05, every other call at 0.8."""
 
-    def __init__(self, skills, obj, state):
+    def __init__(self, skills, obj, state, skill):
         super().__init__(skills)
-        self.obj, self.state = obj, state
+        self.obj, self.state, self.skill = obj, state, skill
 
     def p_success_many(self, queries):
-        return np.array([0.05 if skill == "spin" and self.obj.classify(T) == self.state else self.p
+        return np.array([0.05 if skill == self.skill and self.obj.classify(T) == self.state else self.p
                          for skill, _, T in queries])
 
 
@@ -366,7 +366,7 @@ def test_a_goal_yaw_is_reached_before_the_roll_where_the_goal_state_does_not_spi
         assert [s.skill for s in plan.steps].count("roll") == 1
         return plan, [cube.classify(s.start_pose) for s in plan.steps if s.skill == "spin"]
 
-    plan, states = spin_states(SpinsBadlyIn(skills, cube, target))
+    plan, states = spin_states(RatesBadlyIn(skills, cube, target, "spin"))
     assert states and set(states) == {0}  # every turn in the start state, none after the roll
     roll = next(s for s in plan.steps if s.skill == "roll")
     _, _, _, yaw_after_roll = cube.planar_pose(roll.expected_pose)
@@ -387,7 +387,7 @@ def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn()
     skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
     goal = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(110.0), resting_state=0, yaw_symmetric=False)  # labelled
     T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
-    plan = Planner(cube, (), predictor=SpinsBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, goal)
+    plan = Planner(cube, (), predictor=RatesBadlyIn(skills, cube, 0, "spin"), time_limit=5.0, seed=0).plan(T0, goal)
     assert plan.route[0] == plan.route[-1] == 0 and len(plan.route) == 3
     assert [s.skill for s in plan.steps].count("roll") == 2
     assert {cube.classify(s.start_pose) for s in plan.steps if s.skill == "spin"} == {plan.route[1]}
@@ -406,8 +406,38 @@ def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn()
         planner.record_failure("spin", {"angle": math.radians(45.0)}, T0)
     assert len(planner.plan(T0, goal).route) == 3
     aligned = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(5.0), resting_state=0)
-    plan = Planner(cube, (), predictor=SpinsBadlyIn(skills, cube, 0), time_limit=5.0, seed=0).plan(T0, aligned)
+    plan = Planner(cube, (), predictor=RatesBadlyIn(skills, cube, 0, "spin"), time_limit=5.0, seed=0).plan(T0, aligned)
     assert plan.route == [0]
+
+
+def test_rolls_are_made_near_the_goal_when_the_goal_state_pushes_badly_and_where_the_object_is_otherwise():
+    """The travel happens in the resting state whose pushes the success model rates likelier."""
+    cube = ap.load_object("cube")
+    target = skill_params.roll_targets(cube, 0)[0]
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    goal = ap.Goal(xy=(0.62, 0.1), resting_state=target)
+    T0 = cube.resting_states[0].pose((0.45, -0.1), 0.0)
+
+    def roll_xy_and_push_states(predictor):
+        plan = Planner(cube, (), predictor=predictor, time_limit=5.0, seed=0).plan(T0, goal)
+        roll = next(s for s in plan.steps if s.skill == "roll")
+        states = {cube.classify(s.start_pose) for s in plan.steps if s.skill == "push"}
+        return plan, np.array(roll.start_pose[:2, 3]), states
+
+    plan, roll_xy, states = roll_xy_and_push_states(RatesBadlyIn(skills, cube, target, "push"))
+    assert np.linalg.norm(roll_xy - goal.xy) < 0.03  # rolled at the goal
+    assert states == {0}  # every push lying as it started
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=30)
+    assert ex.success, str(ex)
+    # at most the two pushes of one short correction after the roll (it was made up to XY_TOL off its spot)
+    assert len([e for e in ex.log if e.skill == "push" and cube.classify(e.pose_before) == target]) <= 2
+
+    for predictor in (RatesBadlyIn(skills, cube, 0, "push"), StubPredictor(skills)):  # start state worse, or alike
+        _, roll_xy, states = roll_xy_and_push_states(predictor)
+        assert np.linalg.norm(roll_xy - (0.45, -0.1)) < 1e-6  # rolled where it was
+        assert states == {target}
 
 
 def test_a_goal_yaw_is_met_modulo_the_objects_symmetry():
