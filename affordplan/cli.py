@@ -139,7 +139,7 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
     log = (lambda text: print(text, file=sys.stderr, flush=True)) if args.log else None
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
                         max_primitives=args.max_primitives, progress=not args.json and not args.log,
-                        only=args.task, log=log, weights_dir=args.weights_dir)
+                        only=args.task, log=log, weights_dir=args.weights_dir, draw=args.draw)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -388,7 +388,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="examples:\n  affordplan bench plan --tasks 50 --sim arm --seed 0\n"
                "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json\n"
                "  affordplan bench plan --seed 3 --task 22 42 --planner affordplan --log   # why they failed\n"
-               "  affordplan bench plan --planner affordplan --weights-dir primitives/weights/candidates/push_60",
+               "  affordplan bench plan --planner affordplan --weights-dir primitives/weights/candidates/push_60\n"
+               "  affordplan bench plan --seed 0 --planner affordplan --draw 1   # the same tasks, other random draws",
         formatter_class=_formatter,
     )
     bp.add_argument("--tasks", type=_positive_int, default=50, help="number of tasks (default: %(default)s)")
@@ -405,6 +406,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="run the skills from this folder's files (laid out like primitives/weights/, e.g. "
                          "primitives/weights/candidates/push_60) instead of the shipped ones; a skill without "
                          "files there stays shipped")
+    bp.add_argument("--draw", type=_nonnegative_int, default=0, metavar="K",
+                    help="run the same tasks with the planner's and the simulator's random numbers drawn afresh "
+                         "(K > 0; 0, the default, is the standard run): how far outcomes move by chance alone")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     _register_robustness(bench_sub)

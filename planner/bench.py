@@ -72,6 +72,7 @@ class TaskResult:
 @dataclass
 class BenchReport:
     results: list[TaskResult] = field(default_factory=list)
+    draw: int = 0  # which draw of the run's random numbers (bench_plan's ``draw``)
 
     def summary(self, planner: str) -> dict:
         rs = [r for r in self.results if r.planner == planner]
@@ -109,7 +110,7 @@ class BenchReport:
 
     def as_dict(self) -> dict:
         names = list(dict.fromkeys(r.planner for r in self.results))
-        return dict(versions=versions(), summary=[self.summary(n) for n in names],
+        return dict(versions=versions(), draw=self.draw, summary=[self.summary(n) for n in names],
                     tasks=[asdict(r) for r in self.results])
 
 
@@ -193,11 +194,24 @@ def _describe(task: Task) -> str:
             f"{goal_yaw}")
 
 
+def task_seed(seed: int, task: int, draw: int = 0) -> int:
+    """The seed of task ``task`` of bench seed ``seed`` for planning and executing (OMPL, point-cloud samples):
+    ``seed + task`` in the standard draw (0), as since the bench began; another, independent one per ``draw > 0``."""
+    if draw == 0:
+        return seed + task
+    return int(np.random.SeedSequence([seed, task + 1, draw]).generate_state(1)[0])
+
+
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
                only: Sequence[int] | None = None, log: Callable[[str], None] | None = None,
-               weights_dir: str | os.PathLike | None = None) -> BenchReport:
+               weights_dir: str | os.PathLike | None = None, draw: int = 0) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring).
+
+    ``draw``: 0 runs the standard bench; ``k > 0`` runs the same tasks (objects, scenes, starts, goals) with the
+    run's other random numbers drawn afresh (:func:`task_seed`: OMPL's, and the point-cloud samples of the
+    simulator and of the success-model queries), so that the spread between draws shows how far a task's
+    outcome moves by chance alone, the yardstick for a change that alters plans.
 
     ``weights_dir``: run the skills from this folder's files instead of the shipped ones
     (:func:`primitives.skills.load_skill`; a skill without files there stays shipped), e.g. to bench a
@@ -207,6 +221,8 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
     execution's step log.
     """
+    if draw < 0:
+        raise InputError(f"draw must be >= 0, got {draw}")
     if not 0 < n_tasks <= OBJECTS_PER_SEED:
         raise InputError(f"n_tasks must be 1-{OBJECTS_PER_SEED} (seed S's tasks take test objects "
                          f"{OBJECTS_PER_SEED} S + i), got {n_tasks}")
@@ -215,17 +231,18 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
         raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
     skills = None if weights_dir is None else {name: load_skill(name, weights_dir=weights_dir) for name in SKILLS}
     rng = np.random.default_rng(seed)
-    report = BenchReport()
+    report = BenchReport(draw=draw)
     bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")
     for i in range(max(wanted) + 1):
         task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)  # drawn in order: task i is the same in any run
         if i not in wanted:
             continue
-        predictor = Predictor(obj, skills=skills, seed=seed)
+        predictor = Predictor(obj, skills=skills, seed=seed if draw == 0 else task_seed(seed, -1, draw))
         for name in planners:
             if log is not None:
                 log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")
-            result = run_task(task, obj, name, sim, predictor, seed + i, max_primitives, time_limit, log)
+            result = run_task(task, obj, name, sim, predictor, task_seed(seed, i, draw), max_primitives, time_limit,
+                              log)
             result.task = i
             report.results.append(result)
         bar.update(1)

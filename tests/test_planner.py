@@ -583,6 +583,28 @@ def test_bench_runs_chosen_tasks_of_the_seed_s_draw_and_logs_their_executions():
         bench_plan(50, seed=2, progress=False, only=[OBJECTS_PER_SEED])
 
 
+def test_bench_draws_rerun_the_same_tasks_with_other_random_numbers():
+    """``draw=0`` keeps the seeds the bench always used (``seed + task``); each other draw gives every task its own
+    seed, and runs the very same task (object, scene, start, goal)."""
+    from affordplan.errors import InputError
+    from planner.bench import bench_plan, task_seed
+
+    assert [task_seed(3, i) for i in range(3)] == [3, 4, 5]
+    seeds = {task_seed(s, i, d) for s in range(3) for i in range(-1, 50) for d in (1, 2)}
+    assert len(seeds) == 3 * 51 * 2 and not seeds & set(range(100))
+    assert task_seed(3, 7, 1) == task_seed(3, 7, 1)
+    headers = {}
+    for draw in (0, 1):
+        lines: list[str] = []
+        report = bench_plan(50, sim="finger", seed=2, planners=("greedy",), max_primitives=1, progress=False,
+                            only=[3], log=lines.append, draw=draw)
+        assert report.as_dict()["draw"] == draw and report.results[0].task == 3
+        headers[draw] = lines[0]
+    assert headers[0] == headers[1]
+    with pytest.raises(InputError, match="draw"):
+        bench_plan(50, seed=2, progress=False, only=[3], draw=-1)
+
+
 def test_the_step_log_names_the_resting_states_a_primitive_went_between():
     from planner.execute import LogEntry
 
