@@ -194,12 +194,13 @@ def _describe(task: Task) -> str:
             f"{goal_yaw}")
 
 
-def task_seed(seed: int, task: int, draw: int = 0) -> int:
-    """The seed of task ``task`` of bench seed ``seed`` for planning and executing (OMPL, point-cloud samples):
-    ``seed + task`` in the standard draw (0), as since the bench began; another, independent one per ``draw > 0``."""
+def task_seed(seed: int, task: int | None, draw: int = 0) -> int:
+    """The seed of task ``task`` of bench seed ``seed`` for planning and executing (OMPL, point-cloud samples), or
+    with ``task=None`` the run's own (the success-model queries' point-cloud samples): ``seed + task`` and ``seed``
+    in the standard draw (0), as since the bench began; other, independent ones per ``draw > 0``."""
     if draw == 0:
-        return seed + task
-    return int(np.random.SeedSequence([seed, task + 1, draw]).generate_state(1)[0])
+        return seed if task is None else seed + task
+    return int(np.random.SeedSequence([seed, 0 if task is None else task + 1, draw]).generate_state(1)[0])
 
 
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
@@ -237,7 +238,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
         task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)  # drawn in order: task i is the same in any run
         if i not in wanted:
             continue
-        predictor = Predictor(obj, skills=skills, seed=seed if draw == 0 else task_seed(seed, -1, draw))
+        predictor = Predictor(obj, skills=skills, seed=task_seed(seed, None, draw))
         for name in planners:
             if log is not None:
                 log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")

@@ -589,8 +589,8 @@ def test_bench_draws_rerun_the_same_tasks_with_other_random_numbers():
     from affordplan.errors import InputError
     from planner.bench import bench_plan, task_seed
 
-    assert [task_seed(3, i) for i in range(3)] == [3, 4, 5]
-    seeds = {task_seed(s, i, d) for s in range(3) for i in range(-1, 50) for d in (1, 2)}
+    assert [task_seed(3, i) for i in range(3)] == [3, 4, 5] and task_seed(3, None) == 3
+    seeds = {task_seed(s, i, d) for s in range(3) for i in [None, *range(50)] for d in (1, 2)}
     assert len(seeds) == 3 * 51 * 2 and not seeds & set(range(100))
     assert task_seed(3, 7, 1) == task_seed(3, 7, 1)
     headers = {}
