@@ -1,9 +1,11 @@
 """The one-step environment every primitive trains in (HACMan's, with the skill parameter as its goal).
 
 ``reset`` draws an object (from a procedural split, a fixed list, or the seed's seven; a drawn object
-serves ``episodes_per_object`` consecutive episodes, since building its model costs ~80 ms against
-~12 ms for a primitive), one of its resting states (by its probability), a position in the middle
-of the workspace and a yaw, lets it settle and returns its point cloud. ``step`` takes a contact
+serves ``episodes_per_object`` consecutive episodes, since building its simulator costs ~80 ms against
+~20 ms for a primitive; the object's model, whose resting states and surface samples are most of that
+cost, is kept for later draws, see ``EnvConfig.model_cache``), one of its resting states (by its
+probability), a position in the middle of the workspace and a yaw, lets it settle and returns its
+point cloud. ``step`` takes a contact
 point index and a 3-D motion in [-1, 1], executes the primitive in the finger sim and returns
 ``-L`` of the objective. With probability ``p_params`` an episode asks for a parameter (a push
 direction, a spin angle, a roll target; :mod:`primitives.params`) and the parameterised objective
@@ -49,6 +51,10 @@ class EnvConfig:
     n_points: int = 256
     xy_range: tuple[tuple[float, float], tuple[float, float]] = ((0.45, 0.6), (-0.1, 0.1))
     sim_cache: int = 48  # simulators kept alive per environment (LRU)
+    # Object models kept per environment (LRU; ~0.8 MB each): a simulator rebuilt for an object drawn again
+    # reuses its model, so its resting states (~50 ms with trimesh) and surface samples (~17 ms) are computed
+    # once. 512 holds the whole training split; what an episode sees does not depend on it.
+    model_cache: int = 512
     episodes_per_object: int = 8  # consecutive episodes on one drawn object: amortises its setup
     p_params: float = 0.0  # probability that an episode asks for a parameter (0: the seed's objective)
 
@@ -126,6 +132,7 @@ class PrimitiveEnv:
         self.rng = np.random.default_rng(seed)
         self._seed = seed
         self._sims: OrderedDict[object, Simulator] = OrderedDict()
+        self._models: OrderedDict[object, ObjectModel] = OrderedDict()
         self.sim: Simulator | None = None
         self.seen: SkillObservation | None = None
         self.object_key: object = None
@@ -141,9 +148,16 @@ class PrimitiveEnv:
         return list(c.objects)
 
     def _load(self, key) -> ObjectModel:
-        if isinstance(key, tuple):
-            return random_object(key[1], key[0])
-        return load_object(key)
+        """The model of object ``key``, from the model cache when it was built before."""
+        if key in self._models:
+            self._models.move_to_end(key)
+            return self._models[key]
+        obj = random_object(key[1], key[0]) if isinstance(key, tuple) else load_object(key)
+        if self.config.model_cache > 0:
+            self._models[key] = obj
+            if len(self._models) > self.config.model_cache:
+                self._models.popitem(last=False)
+        return obj
 
     def _simulator(self, key) -> Simulator:
         if key in self._sims:
@@ -211,3 +225,4 @@ class PrimitiveEnv:
         for sim in self._sims.values():
             sim.close()
         self._sims.clear()
+        self._models.clear()

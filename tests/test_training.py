@@ -59,6 +59,30 @@ def test_env_step_returns_the_seed_reward():
     assert res.reward == pytest.approx(-rewards.push_loss(res.outcome.pose_before, res.outcome.pose_after))
 
 
+def test_env_builds_each_object_model_once_and_the_cache_changes_no_episode():
+    """Three objects drawn in turn through one cached simulator: with the model cache each object's model
+    (resting states, surface samples) is built once and reused when its simulator is rebuilt; without it,
+    rebuilt. The clouds and rewards are the same either way."""
+    def run(model_cache):
+        env = PrimitiveEnv(EnvConfig("spin", objects=("cube", "tape", "pill_bottle"), n_points=64,
+                                     episodes_per_object=1, sim_cache=1, model_cache=model_cache), seed=4)
+        seen, rng = [], np.random.default_rng(0)
+        for key in ("cube", "tape", "cube", "pill_bottle", "tape", "cube"):
+            obs = env.reset(object_key=key)
+            res = env.step(int(rng.integers(64)), rng.uniform(-1, 1, size=3))
+            seen.append((key, env.sim.obj, obs, res.reward))
+        env.close()
+        return seen
+
+    cached, uncached = run(512), run(0)
+    models = {}
+    for key, model, _, _ in cached:
+        assert models.setdefault(key, model) is model  # one model per object, reused
+    assert len({id(model) for key, model, _, _ in uncached if key == "cube"}) == 3  # rebuilt each draw (held)
+    for (_, _, obs_c, r_c), (_, _, obs_u, r_u) in zip(cached, uncached):
+        assert np.array_equal(obs_c, obs_u) and r_c == r_u
+
+
 def test_corrupt_checkpoint_gives_a_clear_error(tmp_path):
     path = tmp_path / "checkpoint.pt"
     path.write_bytes(b"not a checkpoint at all")

@@ -16,6 +16,7 @@ marked ``valid=False``. Checks (all vectorised, no per-contact Python):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mujoco
@@ -57,17 +58,21 @@ class PhysicsGuard:
         self._warnings0 = int(self._data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number)
 
     def check(self) -> str | None:
-        """Name of the first fault found, or ``None`` when the state is sane."""
+        """Name of the first fault found, or ``None`` when the state is sane.
+
+        Runs after every 20 ms control chunk, so it reads the 13 numbers as Python floats (a few
+        microseconds; numpy's per-call overhead made it an eighth of a chunk's physics).
+        """
         d = self._data
-        qpos, qvel = d.qpos[self._qpos], d.qvel[self._qvel]
-        if not (np.all(np.isfinite(qpos)) and np.all(np.isfinite(qvel))):
+        qpos, qvel = d.qpos[self._qpos].tolist(), d.qvel[self._qvel].tolist()
+        if not all(map(math.isfinite, qpos + qvel)):
             return "nan"
         if int(d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number) > self._warnings0:
             return "unstable"
         if not self._workspace.contains(qpos[:2], self.limits.workspace_margin):
             return "left_workspace"
-        if (np.linalg.norm(qvel[:3]) > self.limits.max_linear_speed
-                or np.linalg.norm(qvel[3:]) > self.limits.max_angular_speed):
+        if (math.hypot(*qvel[:3]) > self.limits.max_linear_speed
+                or math.hypot(*qvel[3:]) > self.limits.max_angular_speed):
             return "speed"
         if self.lowest_point() < -self.limits.max_penetration:
             return "sank"
