@@ -5,11 +5,10 @@ serves ``episodes_per_object`` consecutive episodes, since building its simulato
 ~20 ms for a primitive; the object's model, whose resting states and surface samples are most of that
 cost, is kept for later draws, see ``EnvConfig.model_cache``), one of its resting states (by its
 probability), a position in the middle of the workspace and a yaw, lets it settle and returns its
-point cloud. ``step`` takes a contact
-point index and a 3-D motion in [-1, 1], executes the primitive in the finger sim and returns
-``-L`` of the objective. With probability ``p_params`` an episode asks for a parameter (a push
-direction, a spin angle, a roll target; :mod:`primitives.params`) and the parameterised objective
-applies; otherwise the seed's.
+point cloud. ``step`` takes a contact point index and a 3-D motion in [-1, 1], executes the primitive
+in the finger sim and returns ``-L`` of the objective. With probability ``p_params`` an episode asks
+for a parameter (a push direction, a spin angle, a roll target; :mod:`primitives.params`) and the
+parameterised objective applies; otherwise the seed's.
 
 Observation, per point (``(n_points, 9)`` float32): ``(x - cx, y - cy, z, nx, ny, nz, fx, fy, fz)``:
 position relative to the cloud's centroid on the table plane (the policy is translation invariant in
