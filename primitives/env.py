@@ -22,7 +22,9 @@ policy's motion is in the same frame; :meth:`SkillObservation.motion_to_world` m
 from __future__ import annotations
 
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -31,6 +33,7 @@ from affordplan.sim.simulator import Outcome, Simulator
 from primitives import params as skill_params
 from primitives import rewards
 
+T = TypeVar("T")
 PRIMITIVES = ("push", "roll", "spin")
 SEED_SEVEN = ("cube", "mug", "tape", "planter_1", "planter_2", "pill_bottle", "lunch_box")
 OBS_DIM = 9
@@ -121,6 +124,20 @@ def skill_observation(sim: Simulator, skill: str, params: dict | None, n_points:
     return observe_cloud(sim.obj, skill, params, points, normals, pose)
 
 
+def _lru(cache: OrderedDict, key, capacity: int, build: Callable[[], T], evict: Callable[[T], None] | None = None) -> T:
+    """``cache[key]``, made by ``build()`` when missing; then the least recently used entries beyond ``capacity``
+    are dropped (each passed to ``evict``), so a capacity of 0 keeps nothing."""
+    if key in cache:
+        cache.move_to_end(key)
+        return cache[key]
+    value = cache[key] = build()
+    while len(cache) > capacity:
+        _, old = cache.popitem(last=False)
+        if evict is not None:
+            evict(old)
+    return value
+
+
 class PrimitiveEnv:
     """One-step environment for ``config.primitive``; seeded, deterministic."""
 
@@ -148,26 +165,12 @@ class PrimitiveEnv:
 
     def _load(self, key) -> ObjectModel:
         """The model of object ``key``, from the model cache when it was built before."""
-        if key in self._models:
-            self._models.move_to_end(key)
-            return self._models[key]
-        obj = random_object(key[1], key[0]) if isinstance(key, tuple) else load_object(key)
-        if self.config.model_cache > 0:
-            self._models[key] = obj
-            if len(self._models) > self.config.model_cache:
-                self._models.popitem(last=False)
-        return obj
+        return _lru(self._models, key, self.config.model_cache,
+                    lambda: random_object(key[1], key[0]) if isinstance(key, tuple) else load_object(key))
 
     def _simulator(self, key) -> Simulator:
-        if key in self._sims:
-            self._sims.move_to_end(key)
-            return self._sims[key]
-        sim = Simulator(self._load(key), seed=int(self.rng.integers(2**31)))
-        self._sims[key] = sim
-        if len(self._sims) > self.config.sim_cache:
-            _, old = self._sims.popitem(last=False)
-            old.close()
-        return sim
+        return _lru(self._sims, key, self.config.sim_cache,
+                    lambda: Simulator(self._load(key), seed=int(self.rng.integers(2**31))), evict=Simulator.close)
 
     # ---------------------------------------------------------------- episode
     def reset(self, object_key=None, resting_state: int | None = None, params="random") -> np.ndarray:

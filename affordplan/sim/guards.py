@@ -2,7 +2,7 @@
 
 The seed paper saw its policies exploit broken physics. A guard looks at the object after every
 control chunk and names the first fault it sees; the primitive is then stopped and its outcome
-marked ``valid=False``. Checks (all vectorised, no per-contact Python):
+marked ``valid=False``. Checks (a few numbers each, no per-contact Python):
 
 - ``"nan"``: a non-finite position or velocity;
 - ``"unstable"``: MuJoCo's bad-acceleration warning fired (it resets the state when it does);
