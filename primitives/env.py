@@ -28,6 +28,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from affordplan.errors import InputError
 from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import params as skill_params
@@ -124,6 +125,22 @@ def skill_observation(sim: Simulator, skill: str, params: dict | None, n_points:
     return observe_cloud(sim.obj, skill, params, points, normals, pose)
 
 
+def check_env_config(config: EnvConfig) -> None:
+    """Raise :class:`InputError` for a configuration the environment cannot run: an unknown primitive, a
+    count below its least value (``sim_cache`` 1: the simulator in use must stay open; ``model_cache`` 0: none
+    kept), or ``p_params`` outside [0, 1]."""
+    if config.primitive not in PRIMITIVES:
+        raise InputError(f"unknown primitive {config.primitive!r}; expected one of {PRIMITIVES}")
+    least = dict(n_objects=1, n_points=16, sim_cache=1, model_cache=0, episodes_per_object=1)
+    for name, low in least.items():
+        value = getattr(config, name)
+        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < low:
+            raise InputError(f"EnvConfig.{name} must be a whole number >= {low}, got {value!r}")
+    p = config.p_params
+    if not isinstance(p, (int, float, np.number)) or isinstance(p, bool) or not 0.0 <= p <= 1.0:  # NaN fails the range
+        raise InputError(f"EnvConfig.p_params is a probability in [0, 1], got {p!r}")
+
+
 def _lru(cache: OrderedDict, key, capacity: int, build: Callable[[], T], evict: Callable[[T], None] | None = None) -> T:
     """``cache[key]``, made by ``build()`` when missing; then the least recently used entries beyond ``capacity``
     are dropped (each passed to ``evict``), so a capacity of 0 keeps nothing."""
@@ -142,8 +159,7 @@ class PrimitiveEnv:
     """One-step environment for ``config.primitive``; seeded, deterministic."""
 
     def __init__(self, config: EnvConfig, seed: int = 0):
-        if config.primitive not in PRIMITIVES:
-            raise ValueError(f"unknown primitive {config.primitive!r}; expected one of {PRIMITIVES}")
+        check_env_config(config)
         self.config = config
         self.rng = np.random.default_rng(seed)
         self._seed = seed

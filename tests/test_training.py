@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ from primitives.env import EnvConfig, PrimitiveEnv
 from primitives.evaluate import evaluate, greedy_action, load_policy
 from primitives.networks import HybridActorCritic, choose_contact
 from primitives.replay import ReplayBuffer
-from primitives.train import TrainConfig, train
+from primitives.train import TrainConfig, bf16_is_fast, train, update
 
 
 def test_maps_are_per_point_and_permutation_equivariant():
@@ -83,6 +84,24 @@ def test_env_builds_each_object_model_once_and_the_cache_changes_no_episode():
         assert np.array_equal(obs_c, obs_u) and r_c == r_u
 
 
+@pytest.mark.parametrize("field, value, words", [
+    ("primitive", "jump", "unknown primitive 'jump'"),
+    ("sim_cache", 0, "EnvConfig.sim_cache must be a whole number >= 1, got 0"),  # would close the sim in use
+    ("model_cache", -1, "EnvConfig.model_cache must be a whole number >= 0, got -1"),
+    ("n_points", 8.0, "EnvConfig.n_points must be a whole number >= 16, got 8.0"),
+    ("episodes_per_object", 0, "EnvConfig.episodes_per_object must be a whole number >= 1"),
+    ("p_params", float("nan"), "EnvConfig.p_params is a probability in [0, 1], got nan"),
+])
+def test_env_refuses_a_config_it_cannot_run(field, value, words):
+    from affordplan.errors import InputError
+
+    with pytest.raises(InputError) as info:
+        PrimitiveEnv(replace(EnvConfig("push", objects=("cube",)), **{field: value}))
+    assert words in str(info.value)
+    env = PrimitiveEnv(EnvConfig("push", objects=("cube",), n_points=16, sim_cache=1, model_cache=0))
+    assert env.reset().shape == (16, 9)  # the least values run
+
+
 def test_corrupt_checkpoint_gives_a_clear_error(tmp_path):
     path = tmp_path / "checkpoint.pt"
     path.write_bytes(b"not a checkpoint at all")
@@ -119,6 +138,33 @@ def test_checkpoint_resume_round_trips(tmp_path):
     assert json.loads((tmp_path / "config.json").read_text())["steps"] == 160
 
 
+def test_resume_lets_go_of_the_loaded_checkpoint(tmp_path, monkeypatch):
+    """After --resume restores the replay into its preallocated buffer, the loaded checkpoint's copy of the
+    replay is freed before training goes on (else a resumed run holds the replay twice: +250 MB on spin's
+    one-hour run)."""
+    import gc
+    import weakref
+
+    import primitives.train as train_mod
+
+    train(_cube_config(tmp_path, 120), progress=False)
+    held, load = [], ckpt.load
+
+    def load_and_watch(path):
+        saved = load(path)
+        held.append(weakref.ref(saved["replay"]["obs"]))
+        return saved
+
+    def update_and_check(*args, **kwargs):
+        gc.collect()
+        assert held and held[0]() is None, "the checkpoint's replay is still referenced during training"
+        return update(*args, **kwargs)
+
+    monkeypatch.setattr(train_mod.ckpt, "load", load_and_watch)
+    monkeypatch.setattr(train_mod, "update", update_and_check)
+    assert train(_cube_config(tmp_path, 140), resume=True, progress=False)["steps"] == 140
+
+
 def _greedy_push(model, n=40):
     env = PrimitiveEnv(EnvConfig("push", objects=("cube",), n_points=128, episodes_per_object=1), seed=99)
     rewards_, successes = [], []
@@ -143,15 +189,43 @@ def _random_push(n=40):
     return float(np.mean(rewards_)), float(np.mean(successes))
 
 
-def test_tiny_run_on_the_cube_learns_to_push(tmp_path):
+@pytest.mark.parametrize("precision", ["fp32", pytest.param("bf16", marks=pytest.mark.skipif(
+    not bf16_is_fast(), reason="no native bfloat16 on this CPU: emulated, too slow for the suite"))])
+def test_tiny_run_on_the_cube_learns_to_push(tmp_path, precision):
     """500 primitives on the cube: the greedy policy beats a random one by >= 0.3 in mean reward
-    (the seed's push loss) and by >= 5 points of push success."""
+    (the seed's push loss) and by >= 5 points of push success, with the learner in float32 or bf16."""
     torch.set_num_threads(1)
-    train(_cube_config(tmp_path, 500), progress=False)
+    train(replace(_cube_config(tmp_path, 500), precision=precision), progress=False)
     trained_reward, trained_success = _greedy_push(load_policy(tmp_path / "policy.pt", "push"))
     random_reward, random_success = _random_push()
     assert trained_reward >= random_reward + 0.3
     assert trained_success >= random_success + 0.05
+
+
+def test_a_bf16_update_is_the_float32_update_up_to_rounding():
+    """From the same weights and batch, one critic + actor update under bf16 autocast moves the weights
+    the way the float32 update does (cosine of the two weight changes > 0.9, per network part), and the
+    weights and optimiser state stay float32."""
+    rng = np.random.default_rng(0)
+    batch = dict(obs=rng.standard_normal((32, 128, 9)).astype(np.float32), index=rng.integers(0, 128, 32),
+                 motion=rng.uniform(-1, 1, (32, 3)).astype(np.float32),
+                 reward=rng.uniform(-2, 0, 32).astype(np.float32))
+    torch.manual_seed(0)
+    start = HybridActorCritic().state_dict()
+    steps = {}
+    for precision in ("fp32", "bf16"):
+        model = HybridActorCritic()
+        model.load_state_dict(start)
+        critic = [*model.backbone.parameters(), *model.q1.parameters(), *model.q2.parameters()]
+        opt_c, opt_a = torch.optim.SGD(critic, lr=1e-2), torch.optim.SGD(model.actor.parameters(), lr=1e-2)
+        critic_loss, actor_loss = update(model, opt_c, opt_a, batch, TrainConfig(precision=precision), n_updates=2)
+        assert np.isfinite(critic_loss) and actor_loss is not None and np.isfinite(actor_loss)
+        assert all(p.dtype == torch.float32 for p in model.parameters())
+        steps[precision] = {k: (v - start[k]).flatten() for k, v in model.state_dict().items()}
+    for part in ("backbone.", "q1.", "q2.", "actor."):
+        a = torch.cat([v for k, v in steps["fp32"].items() if k.startswith(part)])
+        b = torch.cat([v for k, v in steps["bf16"].items() if k.startswith(part)])
+        assert float(torch.nn.functional.cosine_similarity(a, b, dim=0)) > 0.9, part
 
 
 def test_evaluation_is_deterministic():
@@ -226,12 +300,12 @@ def test_shipped_weights_load_offline_and_act(name):
     ("init", "no/such/weights.pt", "--init: no weights file at no/such/weights.pt"),
     # settings without a flag are named as TrainConfig fields
     ("epsilon", -0.1, "TrainConfig.epsilon is a probability in [0, 1]"),
-    ("replay_ratio", 0.0, "TrainConfig.replay_ratio must be a positive number"),
+    ("replay_ratio", 0.0, "--replay-ratio must be a positive number"),
+    ("precision", "fp16", "--precision must be one of ('fp32', 'bf16'), got 'fp16'"),
     ("actor_delay", 0, "TrainConfig.actor_delay must be a whole number >= 1"),
     ("sim_cache", 0, "TrainConfig.sim_cache must be a whole number >= 1"),
 ])
 def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field, value, words):
-    from dataclasses import replace
 
     from affordplan.errors import InputError
     from primitives.train import TrainConfig, check_config, train
