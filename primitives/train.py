@@ -31,7 +31,7 @@ Read top to bottom, CleanRL style. Choices and why:
   success rates count executed primitives only.
 - **bf16 learner (optional).** ``--precision bf16`` runs the learner's forward passes under
   ``torch.autocast`` in bfloat16 (weights, gradients and Adam stay float32; losses are taken in
-  float32). On a CPU with AMX or AVX512-BF16 an update costs less than half (32 against 71 ms, batch
+  float32). On a CPU with AMX or AVX512-BF16 an update costs less than half (31 against 71 ms, batch
   32, one thread), so the same hour buys twice the updates (``--replay-ratio 16``); elsewhere it is
   emulated and slower, and the run says so. Workers act in float32 either way.
 - **Invalid samples are dropped.** Primitives flagged by the physics guards never enter the replay.
