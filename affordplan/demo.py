@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from affordplan.checks import require_whole
 from affordplan.errors import InputError
 from affordplan.geometry import transform_points
 from affordplan.goal import Goal
@@ -165,8 +166,7 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
 
     if sim not in ("arm", "finger"):
         raise InputError(f"sim must be 'arm' or 'finger', got {sim!r}")
-    if isinstance(max_primitives, bool) or not isinstance(max_primitives, int) or max_primitives < 1:
-        raise InputError(f"max_primitives must be a positive integer, got {max_primitives!r}")
+    require_whole("max_primitives", max_primitives, 1)
     if not fps > 0:
         raise InputError(f"fps must be positive, got {fps!r}")
     t_start = time.perf_counter()

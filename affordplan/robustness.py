@@ -42,6 +42,7 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
+from affordplan.checks import require_whole
 from affordplan.errors import InputError, ReachabilityError
 from affordplan.geometry import transform_points
 from affordplan.objects.model import catalogue, load_object
@@ -217,8 +218,7 @@ def run(primitives: int = 10_000, seed: int = 0, sim: str = "finger", objects: l
     The run is deterministic for a given ``seed`` (physics is deterministic and every draw comes from
     one seeded generator). See the module docstring for the kinds and the bins.
     """
-    if isinstance(primitives, bool) or not isinstance(primitives, int) or primitives < 1:
-        raise InputError(f"primitives must be a positive integer, got {primitives!r}")
+    require_whole("primitives", primitives, 1)
     if sim not in ("finger", "arm"):
         raise InputError(f"sim must be 'finger' or 'arm', got {sim!r}")
     names = list(objects) if objects else catalogue()

@@ -28,6 +28,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from affordplan.checks import require_probability, require_whole
 from affordplan.errors import InputError
 from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.sim.simulator import Outcome, Simulator
@@ -133,12 +134,8 @@ def check_env_config(config: EnvConfig) -> None:
         raise InputError(f"unknown primitive {config.primitive!r}; expected one of {PRIMITIVES}")
     least = dict(n_objects=1, n_points=16, sim_cache=1, model_cache=0, episodes_per_object=1)
     for name, low in least.items():
-        value = getattr(config, name)
-        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < low:
-            raise InputError(f"EnvConfig.{name} must be a whole number >= {low}, got {value!r}")
-    p = config.p_params
-    if not isinstance(p, (int, float, np.number)) or isinstance(p, bool) or not 0.0 <= p <= 1.0:  # NaN fails the range
-        raise InputError(f"EnvConfig.p_params is a probability in [0, 1], got {p!r}")
+        require_whole(f"EnvConfig.{name}", getattr(config, name), low)
+    require_probability("EnvConfig.p_params", config.p_params)
 
 
 def _lru(cache: OrderedDict, key, capacity: int, build: Callable[[], T], evict: Callable[[T], None] | None = None) -> T:

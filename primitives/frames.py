@@ -53,6 +53,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.special import expit, logit
 
+from affordplan.checks import is_whole, require_whole
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives import params as skill_params
@@ -75,8 +76,7 @@ def free_frames(skill: str, params: dict | None, n_turns: int, mirror: bool) -> 
     ``n_turns``: turns about the vertical to try where a turn is free, evenly spaced (1: none). ``mirror``: also
     try the mirror of each, where it is free.
     """
-    if not isinstance(n_turns, int) or isinstance(n_turns, bool) or n_turns < 1:
-        raise InputError(f"n_turns must be a whole number >= 1, got {n_turns!r}")
+    require_whole("n_turns", n_turns, 1)
     turn_free = params is None or skill == "spin"
     mirror_free = mirror and (params is None or skill != "spin")
     turns = [rot_z(2.0 * math.pi * k / n_turns) for k in range(n_turns if turn_free else 1)]
@@ -148,8 +148,7 @@ class FrameSearch:
 
     def __post_init__(self):
         free_frames("spin", None, self.turns, self.mirror)  # checks turns
-        if (not isinstance(self.stand_ins, int) or isinstance(self.stand_ins, bool) or self.stand_ins < 0
-                or (self.stand_ins and self.stand_ins % self.turns)):
+        if not is_whole(self.stand_ins) or self.stand_ins < 0 or (self.stand_ins and self.stand_ins % self.turns):
             raise InputError(f"stand_ins must be 0 or a whole multiple of turns ({self.turns}), got {self.stand_ins!r}")
         for ab in (self.platt, self.platt_unparameterised, self.platt_stand_ins):
             if len(ab) != 2 or not all(math.isfinite(v) for v in ab):

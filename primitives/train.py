@@ -50,7 +50,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import math
 import resource
 import sys
 import time
@@ -63,6 +62,7 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
+from affordplan.checks import is_finite, require_probability, require_whole
 from affordplan.errors import InputError
 from primitives import checkpoint as ckpt
 from primitives.env import PRIMITIVES, EnvConfig, PrimitiveEnv
@@ -121,10 +121,6 @@ def exploration(cfg: TrainConfig) -> Exploration:
     return Exploration(cfg.temperature, cfg.epsilon, cfg.motion_noise, cfg.p_scripted, cfg.hindsight)
 
 
-def _finite(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-
-
 # Settings the command line sets; the others are TrainConfig fields only.
 _CLI_SETTINGS = frozenset({"steps", "workers", "max_minutes", "checkpoint_minutes", "lr", "p_params", "p_scripted",
                            "batch_size", "replay_size", "learning_starts", "weight_sync_updates", "n_points",
@@ -147,17 +143,14 @@ def check_config(cfg: TrainConfig) -> None:
                   weight_sync_updates=(cfg.weight_sync_updates, 1), log_every_steps=(cfg.log_every_steps, 1),
                   actor_delay=(cfg.actor_delay, 1), sim_cache=(cfg.sim_cache, 1), n_objects=(cfg.n_objects, 1))
     for name, (value, least) in counts.items():
-        if not isinstance(value, int) or isinstance(value, bool) or value < least:
-            raise InputError(f"{_setting(name)} must be a whole number >= {least}, got {value!r}")
+        require_whole(_setting(name), value, least)
     for name in ("max_minutes", "checkpoint_minutes", "lr", "temperature", "replay_ratio"):
         value = getattr(cfg, name)
-        if not _finite(value) or value <= 0:
+        if not is_finite(value) or value <= 0:
             raise InputError(f"{_setting(name)} must be a positive number, got {value!r}")
     for name in ("p_params", "p_scripted", "epsilon"):
-        value = getattr(cfg, name)
-        if not _finite(value) or not 0.0 <= value <= 1.0:
-            raise InputError(f"{_setting(name)} is a probability in [0, 1], got {value!r}")
-    if not _finite(cfg.motion_noise) or cfg.motion_noise < 0:
+        require_probability(_setting(name), getattr(cfg, name))
+    if not is_finite(cfg.motion_noise) or cfg.motion_noise < 0:
         raise InputError(f"{_setting('motion_noise')} must be a number >= 0, got {cfg.motion_noise!r}")
     if cfg.init is not None and not Path(cfg.init).is_file():
         raise InputError(f"--init: no weights file at {cfg.init}")

@@ -323,3 +323,12 @@ def test_bench_sim2sim_compares_identical_primitives():
     assert np.all(r.displacement_diff_m >= 0) and np.all(r.rotation_diff_rad >= 0)
     assert "p90" in r.report()
 
+
+
+@pytest.mark.parametrize("max_primitives", [0, 1.5, True])
+def test_run_scene_refuses_a_primitive_budget_that_is_not_a_whole_number(max_primitives, tmp_path):
+    from affordplan.demo import run_scene
+
+    with pytest.raises(InputError, match="max_primitives must be a whole number >= 1"):
+        run_scene(demo_scene(), tmp_path, max_primitives=max_primitives, video=False, progress=False)
+    assert not any(tmp_path.iterdir())  # refused before anything was written

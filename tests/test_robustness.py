@@ -48,8 +48,10 @@ def test_fuzz_is_deterministic():
 
 
 def test_bad_arguments():
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="primitives must be a whole number >= 1, got 0"):
         robustness.run(0, progress=False)
+    with pytest.raises(InputError, match="got 2.5"):
+        robustness.run(2.5, progress=False)
     with pytest.raises(InputError):
         robustness.run(5, sim="hand", progress=False)
 
