@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordplan.checks import is_whole
 from affordplan.errors import GoalError
 from affordplan.geometry import wrap_period
 from affordplan.objects.model import ObjectModel
@@ -49,8 +50,7 @@ class Goal:
             if not isinstance(self.yaw, (int, float, np.floating)) or not math.isfinite(self.yaw):
                 raise GoalError(f"goal yaw must be a finite angle in radians or None, got {self.yaw!r}")
             object.__setattr__(self, "yaw", float(self.yaw))
-        if self.resting_state is not None and (
-                not isinstance(self.resting_state, (int, np.integer)) or isinstance(self.resting_state, bool)):
+        if self.resting_state is not None and not is_whole(self.resting_state):
             raise GoalError(f"goal resting_state must be an integer index or None, got {self.resting_state!r}")
         if not isinstance(self.yaw_symmetric, (bool, np.bool_)):
             raise GoalError(f"goal yaw_symmetric must be True or False, got {self.yaw_symmetric!r}")

@@ -14,6 +14,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from affordplan.checks import is_whole
 from affordplan.errors import InputError
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
@@ -30,7 +31,7 @@ def render_states(obj: ObjectModel, states: list[int] | None = None, width: int 
     n = len(obj.resting_states)
     states = list(range(n)) if states is None else list(states)
     for s in states:
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or not 0 <= s < n:
+        if not is_whole(s) or not 0 <= s < n:
             raise InputError(f"{obj.name} has {n} resting states (0..{n - 1}), got state {s!r}")
     sim = Simulator(obj, seed=seed)
     m = sim.model

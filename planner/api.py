@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from affordplan.checks import is_whole
 from affordplan.errors import GoalError, InputError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
@@ -29,7 +30,7 @@ def start_pose(obj: ObjectModel, start) -> np.ndarray:
             raise InputError(f"start takes resting_state, xy and yaw; got {sorted(unknown)}")
         state = start.get("resting_state", 0)
         n = len(obj.resting_states)
-        if isinstance(state, bool) or not isinstance(state, (int, np.integer)):
+        if not is_whole(state):
             raise InputError(f"start resting_state must be an integer index, got {state!r}")
         if not 0 <= state < n:
             raise GoalError(f"start resting_state {state} does not exist: {obj.name} has {n} resting states "

@@ -14,6 +14,7 @@ import math
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from affordplan.checks import is_whole
 from affordplan.errors import InputError
 from affordplan.objects.model import ObjectModel
 
@@ -60,7 +61,7 @@ def footprint(obj: ObjectModel, state: int) -> np.ndarray:
         InputError: ``state`` is not an index of ``obj.resting_states``.
     """
     states = obj.resting_states
-    if isinstance(state, bool) or not isinstance(state, (int, np.integer)) or not 0 <= state < len(states):
+    if not is_whole(state) or not 0 <= state < len(states):
         raise InputError(f"state must be an int in [0, {len(states)}), got {state!r}")
     R_world_object = states[int(state)].rotation
     p_world = np.asarray(obj.hull.vertices, dtype=float) @ R_world_object.T

@@ -42,6 +42,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from affordplan.checks import is_whole
 from affordplan.errors import GoalError, InputError, PlanningError
 from affordplan.geometry import rot_z, wrap_angle
 from affordplan.world import Box, Workspace
@@ -483,9 +484,9 @@ def plan_path(
     time_limit = _check_positive(time_limit, "time_limit")
     resolution = _check_positive(resolution, "resolution")
     yaw_weight = _check_positive(yaw_weight, "yaw_weight")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**32 - 1:
+    if not is_whole(seed) or not 0 <= seed < 2**32 - 1:
         raise InputError(f"seed must be an int in [0, 2**32 - 1), got {seed!r}")
-    if isinstance(attempts, bool) or not isinstance(attempts, (int, np.integer)) or attempts < 1:
+    if not is_whole(attempts) or attempts < 1:
         raise InputError(f"attempts must be an int >= 1, got {attempts!r}")
     for name, pose in (("start", start), ("goal", goal)):
         reason = checker.why_not_free(*pose)

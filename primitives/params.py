@@ -36,6 +36,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from affordplan.checks import is_whole
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z, wrap_angle
 from affordplan.objects.model import ObjectModel
@@ -79,7 +80,7 @@ def check(skill: str, params, obj: ObjectModel | None = None, state: int | None 
         raise InputError(f"{skill} takes params {{{key!r}: ...}}, got {params!r}")
     value = params[key]
     if skill == "roll":
-        if not isinstance(value, (int, np.integer)) or isinstance(value, bool):
+        if not is_whole(value):
             raise InputError(f"roll target must be a resting-state index, got {value!r}")
         if obj is not None:
             n = len(obj.resting_states)

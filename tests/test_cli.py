@@ -324,7 +324,6 @@ def test_bench_sim2sim_compares_identical_primitives():
     assert "p90" in r.report()
 
 
-
 @pytest.mark.parametrize("max_primitives", [0, 1.5, True])
 def test_run_scene_refuses_a_primitive_budget_that_is_not_a_whole_number(max_primitives, tmp_path):
     from affordplan.demo import run_scene
