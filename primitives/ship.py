@@ -1,0 +1,221 @@
+"""Ship a candidate set of one skill's files as the package's weights, keeping the old ones and the provenance.
+
+    python -m primitives.ship push --from primitives/weights/candidates/push_60_bf16 --keep push_0.16 --release 0.18.0
+    python -m primitives.ship push --from DIR --keep NAME --dry-run     # print what would move, change nothing
+
+A **candidate set** is a folder laid out like ``primitives/weights/`` (what ``--weights-dir`` runs): ``{skill}.pt``
+(the policy) and ``{skill}_success.pt`` (its goal-frame success model), optionally ``{skill}_frames.json`` (the
+frame search's calibration) and ``{skill}_success_searched.pt`` (the searched success model), and any other file
+of the skill (``{skill}_config.json``, ``{skill}_log.csv``, ``{skill}.eval_*.json``, ``*.train.json``). A skill's
+files are those named ``{skill}.*`` or ``{skill}_*``.
+
+Shipping does, in this order, and changes nothing until every check has passed:
+
+1. **Check** that the set loads as a skill (:func:`primitives.load_skill` with ``weights_dir``) and that its
+   fitted files were fitted with *its* files: each run path their ``info`` names (``policy``, ``model``,
+   ``frames``) must, where it exists on this machine, be byte for byte (sha256) the set's file of that role.
+   A path that is absent here is reported, not refused; ``"shipped"`` (a set that was shipped before) passes.
+2. **Keep** the skill's shipped files: move them to ``candidates/KEEP/`` beside the weights (refused if that
+   folder exists), so that ``--weights-dir primitives/weights/candidates/KEEP`` still runs them.
+3. **Copy** the set's files in. In the fitted files (both success models, the frames file) each of ``policy``,
+   ``model`` and ``frames`` that names a path becomes ``"shipped"``; the path moves to ``trained_with``; and a
+   ``note`` records the release and the sha256 of the shipped files it was fitted with. The weights themselves
+   are not touched.
+
+This is what releases 0.17 (roll), 0.18 (push) and 0.19 (spin) did by hand. The record of commands and figures
+(``weights/RECORD.md``) is still written by hand; the command prints what to put in it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import shutil
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import torch
+
+from affordplan.errors import AffordplanError, InputError
+from primitives.env import PRIMITIVES
+from primitives.success import WEIGHTS_DIR
+
+ROLES = ("policy", "model", "frames")  # the info keys of a fitted file that name the files it was fitted with
+SHIPPED = "shipped"
+
+
+def role_files(skill: str) -> dict[str, str]:
+    """The file name of each role in a weights folder: ``policy``, ``model`` (the goal-frame success model),
+    ``frames``; and ``searched``, the searched success model (fitted, but named by no other file's info)."""
+    return {"policy": f"{skill}.pt", "model": f"{skill}_success.pt", "frames": f"{skill}_frames.json",
+            "searched": f"{skill}_success_searched.pt"}
+
+
+def skill_files(folder: Path, skill: str) -> list[Path]:
+    """The files of ``skill`` directly in ``folder`` (``{skill}.*`` and ``{skill}_*``), sorted by name."""
+    return sorted(p for p in folder.iterdir()
+                  if p.is_file() and (p.name.startswith(f"{skill}.") or p.name.startswith(f"{skill}_")))
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def read_info(path: Path) -> dict:
+    """The ``info`` of a fitted file: a success model (``.pt``) or a frames file (``.json``)."""
+    try:
+        if path.suffix == ".json":
+            return dict(json.loads(path.read_text()).get("info", {}))
+        return dict(torch.load(path, map_location="cpu", weights_only=False).get("info", {}))
+    except Exception as exc:
+        raise InputError(f"{path} cannot be read ({type(exc).__name__}: {exc})") from exc
+
+
+@dataclass
+class ShipPlan:
+    """What :func:`plan_ship` found: the files to keep and to copy, and the provenance checks."""
+
+    skill: str
+    source: Path
+    weights_dir: Path
+    keep_dir: Path
+    to_keep: list[Path]
+    to_copy: list[Path]
+    checked: list[str] = field(default_factory=list)  # "model: policy runs/x/policy.pt = push.pt (sha256 ab12...)"
+    unchecked: list[str] = field(default_factory=list)  # run paths absent from this machine
+
+    def describe(self) -> str:
+        lines = [f"ship {self.skill} from {self.source} into {self.weights_dir}",
+                 f"keep {len(self.to_keep)} shipped file(s) in {self.keep_dir}:"]
+        lines += [f"  {p.name}" for p in self.to_keep]
+        lines += [f"copy {len(self.to_copy)} file(s):"] + [f"  {p.name}" for p in self.to_copy]
+        lines += ["provenance, byte for byte:"] + [f"  {c}" for c in self.checked]
+        lines += [f"  not checked (absent here): {u}" for u in self.unchecked]
+        return "\n".join(lines)
+
+
+def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path | None = None,
+              base: str | Path = ".") -> ShipPlan:
+    """Check a candidate set (module docstring, step 1) and say what shipping it would move; change nothing.
+
+    ``base``: the folder that relative run paths in the files' ``info`` are taken from (the repository root,
+    where the training commands ran). Raises :class:`InputError` for a set that cannot ship.
+    """
+    from primitives.skills import load_skill
+
+    if skill not in PRIMITIVES:
+        raise InputError(f"unknown skill {skill!r}; expected one of {PRIMITIVES}")
+    source = Path(source)
+    weights_dir = Path(weights_dir) if weights_dir is not None else WEIGHTS_DIR
+    if not source.is_dir():
+        raise InputError(f"candidate set {str(source)!r} is not a folder")
+    if source.resolve() == weights_dir.resolve():
+        raise InputError("the candidate set is the weights folder itself")
+    if not keep or Path(keep).name != keep or keep in (".", ".."):
+        raise InputError(f"--keep must be a plain folder name under candidates/, got {keep!r}")
+    keep_dir = weights_dir / "candidates" / keep
+    if keep_dir.exists():
+        raise InputError(f"{keep_dir} exists already; choose another --keep name")
+    names = role_files(skill)
+    for role in ("policy", "model"):
+        if not (source / names[role]).exists():
+            raise InputError(f"the candidate set has no {names[role]} (its {role})")
+    try:
+        load_skill(skill, weights_dir=source)
+    except AffordplanError as exc:
+        raise InputError(f"the candidate set does not load as the {skill} skill: {exc}") from exc
+    plan = ShipPlan(skill, source, weights_dir, keep_dir, skill_files(weights_dir, skill), skill_files(source, skill))
+    for fitted in ("model", "frames", "searched"):
+        path = source / names[fitted]
+        if not path.exists():
+            continue
+        info = read_info(path)
+        for role in ROLES:
+            named = info.get(role)
+            if named is None or role == fitted or named == SHIPPED:
+                continue
+            own = source / names[role]
+            if not own.exists():
+                raise InputError(f"{path.name} was fitted with a {role} ({named}) the set does not hold ({own.name})")
+            run_file = Path(named) if Path(named).is_absolute() else Path(base) / named
+            if not run_file.exists():
+                plan.unchecked.append(f"{path.name}: {role} {named}")
+                continue
+            digest = sha256(run_file)
+            if digest != sha256(own):
+                raise InputError(f"{path.name} was fitted with {named}, which is not the set's {own.name} "
+                                 f"(sha256 {digest[:12]} against {sha256(own)[:12]})")
+            plan.checked.append(f"{path.name}: {role} {named} = {own.name} (sha256 {digest[:12]})")
+    return plan
+
+
+def relabel(path: Path, release: str, digests: dict[str, str]) -> None:
+    """Rewrite the ``info`` of a fitted file as shipped (module docstring, step 3); its model is untouched."""
+    def update(info: dict) -> dict:
+        trained_with = {role: info[role] for role in ROLES if role in info and info[role] != SHIPPED}
+        if not trained_with:
+            return info
+        for role in trained_with:
+            info[role] = SHIPPED
+        info["trained_with"] = {**info.get("trained_with", {}), **trained_with}
+        fitted_with = ", ".join(f"{role} sha256 {digests[role][:12]}" for role in trained_with if role in digests)
+        info["note"] = f"trained with the files shipped in {release}: {fitted_with}"
+        return info
+
+    if path.suffix == ".json":
+        data = json.loads(path.read_text())
+        data["info"] = update(dict(data.get("info", {})))
+        path.write_text(json.dumps(data, indent=2) + "\n")
+    else:
+        state = torch.load(path, map_location="cpu", weights_only=False)
+        state["info"] = update(dict(state.get("info", {})))
+        torch.save(state, path)
+
+
+def ship(plan: ShipPlan, release: str) -> None:
+    """Carry out a :func:`plan_ship` (module docstring, steps 2-3)."""
+    names = role_files(plan.skill)
+    digests = {role: sha256(plan.source / names[role]) for role in ROLES if (plan.source / names[role]).exists()}
+    plan.keep_dir.mkdir(parents=True)
+    for path in plan.to_keep:
+        shutil.move(str(path), plan.keep_dir / path.name)
+    for path in plan.to_copy:
+        shutil.copy2(path, plan.weights_dir / path.name)
+    for fitted in ("model", "frames", "searched"):
+        path = plan.weights_dir / names[fitted]
+        if path.exists() and (plan.source / names[fitted]).exists():
+            relabel(path, release, digests)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m primitives.ship", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("skill", choices=PRIMITIVES)
+    parser.add_argument("--from", dest="source", required=True, help="the candidate set (a folder like weights/)")
+    parser.add_argument("--keep", required=True, help="folder name under weights/candidates/ for the files now shipped")
+    parser.add_argument("--release", default=None, help="the release the note names (default: the package version)")
+    parser.add_argument("--weights-dir", default=None, help="the weights folder to ship into (default: the package's)")
+    parser.add_argument("--dry-run", action="store_true", help="check and print what would move; change nothing")
+    args = parser.parse_args(argv)
+    try:
+        plan = plan_ship(args.skill, args.source, args.keep, args.weights_dir)
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(plan.describe())
+    if args.dry_run:
+        print("dry run: nothing changed")
+        return 0
+    if args.release is None:
+        import affordplan
+
+        args.release = affordplan.__version__
+    ship(plan, args.release)
+    print(f"shipped; the previous files are in {plan.keep_dir}. Record the command and figures in weights/RECORD.md.")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,123 @@
+"""Shipping a candidate set (primitives.ship): the old files are kept, the new ones copied with their provenance
+relabelled and their weights untouched, and a set fitted with other files is refused before anything moves."""
+
+import hashlib
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+import torch
+
+from affordplan.errors import InputError
+from primitives import load_skill
+from primitives.ship import main, plan_ship, ship
+from primitives.success import WEIGHTS_DIR
+
+CORE = ("push.pt", "push_success.pt", "push_frames.json", "push_success_searched.pt")
+
+
+def digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def set_info(path: Path, **values) -> None:
+    if path.suffix == ".json":
+        data = json.loads(path.read_text())
+        data["info"].update(values)
+        path.write_text(json.dumps(data))
+    else:
+        state = torch.load(path, weights_only=False)
+        state["info"].update(values)
+        torch.save(state, path)
+
+
+@pytest.fixture
+def layout(tmp_path):
+    """A weights folder holding the shipped push, and a candidate set (the 0.16 push) whose fitted files name
+    run paths under ``base``, as a fresh refit's would."""
+    weights, cand, base = tmp_path / "weights", tmp_path / "cand", tmp_path / "base"
+    weights.mkdir()
+    cand.mkdir()
+    for name in CORE + ("push_log.csv",):
+        shutil.copy2(WEIGHTS_DIR / name, weights / name)
+    for name in CORE + ("push.eval_seed7.json",):
+        shutil.copy2(WEIGHTS_DIR / "candidates" / "push_0.16" / name, cand / name)
+    runs = {"policy": "runs/p/policy.pt", "model": "runs/s/success.pt", "frames": "runs/f/frames.json"}
+    for role, own in (("policy", "push.pt"), ("model", "push_success.pt"), ("frames", "push_frames.json")):
+        (base / runs[role]).parent.mkdir(parents=True)
+        shutil.copy2(cand / own, base / runs[role])
+    set_info(cand / "push_success.pt", policy=runs["policy"])
+    set_info(cand / "push_frames.json", policy=runs["policy"], model=runs["model"])
+    set_info(cand / "push_success_searched.pt", **runs)
+    # the run files of the two fitted-with files now differ from the set's (their info changed): refresh them
+    shutil.copy2(cand / "push_success.pt", base / runs["model"])
+    shutil.copy2(cand / "push_frames.json", base / runs["frames"])
+    return weights, cand, base, runs
+
+
+def test_shipping_keeps_the_old_files_and_relabels_the_new(layout):
+    weights, cand, base, runs = layout
+    old = {p.name: digest(p) for p in weights.iterdir()}
+    plan = plan_ship("push", cand, "push_old", weights_dir=weights, base=base)
+    assert len(plan.checked) == 6 and not plan.unchecked  # policy x3, model x2, frames x1
+    ship(plan, "9.9.9")
+
+    kept = weights / "candidates" / "push_old"
+    assert {p.name: digest(p) for p in kept.iterdir()} == old  # moved whole, bytes unchanged
+    assert not (weights / "push_log.csv").exists()  # a file of the old set that the new one lacks is not left behind
+    assert digest(weights / "push.pt") == digest(cand / "push.pt")  # the policy is copied as it is
+    assert (weights / "push.eval_seed7.json").read_bytes() == (cand / "push.eval_seed7.json").read_bytes()
+
+    searched = torch.load(weights / "push_success_searched.pt", weights_only=False)
+    info = searched["info"]
+    assert info["policy"] == info["model"] == info["frames"] == "shipped"
+    assert info["trained_with"] == runs and "9.9.9" in info["note"] and digest(cand / "push.pt")[:12] in info["note"]
+    source = torch.load(cand / "push_success_searched.pt", weights_only=False)
+    assert all(torch.equal(searched["model"][k], source["model"][k]) for k in source["model"])  # weights untouched
+    frames = json.loads((weights / "push_frames.json").read_text())
+    assert frames["info"]["trained_with"] == {"policy": runs["policy"], "model": runs["model"]}
+    assert frames["platt"] == json.loads((cand / "push_frames.json").read_text())["platt"]
+
+    skill = load_skill("push", weights_dir=weights)  # the shipped layout loads, with its search and searched model
+    assert skill.frame_search is not None and skill.frame_search.info["policy"] == "shipped"
+    assert skill.searched_model is not None
+
+
+def test_a_set_fitted_with_another_policy_is_refused_before_anything_moves(layout):
+    weights, cand, base, runs = layout
+    shutil.copy2(WEIGHTS_DIR / "push.pt", base / runs["policy"])  # the run's policy is not the set's
+    before = {p.name: digest(p) for p in weights.iterdir()}
+    with pytest.raises(InputError, match="fitted with runs/p/policy.pt, which is not the set's push.pt"):
+        plan_ship("push", cand, "push_old", weights_dir=weights, base=base)
+    assert {p.name: digest(p) for p in weights.iterdir()} == before
+
+
+def test_run_paths_absent_here_are_reported_not_refused(layout, capsys):
+    weights, cand, base, _ = layout
+    plan = plan_ship("push", cand, "push_old", weights_dir=weights, base=base / "elsewhere")
+    assert len(plan.unchecked) == 6 and not plan.checked
+    assert main(["push", "--from", str(cand), "--keep", "push_old", "--weights-dir", str(weights), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "not checked (absent here)" in out and "dry run: nothing changed" in out
+    assert not (weights / "candidates").exists()
+
+
+@pytest.mark.parametrize("case", ["keep exists", "no success model", "bad keep name", "unknown skill", "same folder"])
+def test_sets_that_cannot_ship_are_refused(layout, case):
+    weights, cand, base, _ = layout
+    skill, keep, source = "push", "push_old", cand
+    if case == "keep exists":
+        (weights / "candidates" / "push_old").mkdir(parents=True)
+    elif case == "no success model":
+        (cand / "push_success.pt").unlink()
+    elif case == "bad keep name":
+        keep = "../push_old"
+    elif case == "unknown skill":
+        skill = "throw"
+    else:
+        source = weights
+    before = sorted(p.name for p in weights.rglob("*"))
+    with pytest.raises(InputError):
+        plan_ship(skill, source, keep, weights_dir=weights, base=base)
+    assert sorted(p.name for p in weights.rglob("*")) == before
