@@ -30,16 +30,16 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import json
 import shutil
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import torch
 
 from affordplan.errors import AffordplanError, InputError
 from primitives.env import PRIMITIVES
+from primitives.frames import FrameSearch
 from primitives.success import WEIGHTS_DIR
 
 ROLES = ("policy", "model", "frames")  # the info keys of a fitted file that name the files it was fitted with
@@ -64,10 +64,11 @@ def sha256(path: Path) -> str:
 
 
 def read_info(path: Path) -> dict:
-    """The ``info`` of a fitted file: a success model (``.pt``) or a frames file (``.json``)."""
+    """The ``info`` of a fitted file: a success model (``.pt``) or a frames file (``.json``, read by
+    :meth:`FrameSearch.load`, which raises :class:`InputError` for an unreadable one)."""
+    if path.suffix == ".json":
+        return dict(FrameSearch.load(path).info)
     try:
-        if path.suffix == ".json":
-            return dict(json.loads(path.read_text()).get("info", {}))
         return dict(torch.load(path, map_location="cpu", weights_only=False).get("info", {}))
     except Exception as exc:
         raise InputError(f"{path} cannot be read ({type(exc).__name__}: {exc})") from exc
@@ -83,6 +84,7 @@ class ShipPlan:
     keep_dir: Path
     to_keep: list[Path]
     to_copy: list[Path]
+    digests: dict[str, str]  # sha256 of the set's file of each role it holds (policy, model, frames)
     checked: list[str] = field(default_factory=list)  # "model: policy runs/x/policy.pt = push.pt (sha256 ab12...)"
     unchecked: list[str] = field(default_factory=list)  # run paths absent from this machine
 
@@ -126,7 +128,9 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
         load_skill(skill, weights_dir=source)
     except AffordplanError as exc:
         raise InputError(f"the candidate set does not load as the {skill} skill: {exc}") from exc
-    plan = ShipPlan(skill, source, weights_dir, keep_dir, skill_files(weights_dir, skill), skill_files(source, skill))
+    digests = {role: sha256(source / names[role]) for role in ROLES if (source / names[role]).exists()}
+    plan = ShipPlan(skill, source, weights_dir, keep_dir, skill_files(weights_dir, skill), skill_files(source, skill),
+                    digests)
     for fitted in ("model", "frames", "searched"):
         path = source / names[fitted]
         if not path.exists():
@@ -137,16 +141,16 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
             if named is None or role == fitted or named == SHIPPED:
                 continue
             own = source / names[role]
-            if not own.exists():
+            if role not in digests:
                 raise InputError(f"{path.name} was fitted with a {role} ({named}) the set does not hold ({own.name})")
             run_file = Path(named) if Path(named).is_absolute() else Path(base) / named
             if not run_file.exists():
                 plan.unchecked.append(f"{path.name}: {role} {named}")
                 continue
             digest = sha256(run_file)
-            if digest != sha256(own):
+            if digest != digests[role]:
                 raise InputError(f"{path.name} was fitted with {named}, which is not the set's {own.name} "
-                                 f"(sha256 {digest[:12]} against {sha256(own)[:12]})")
+                                 f"(sha256 {digest[:12]} against {digests[role][:12]})")
             plan.checked.append(f"{path.name}: {role} {named} = {own.name} (sha256 {digest[:12]})")
     return plan
 
@@ -165,9 +169,8 @@ def relabel(path: Path, release: str, digests: dict[str, str]) -> None:
         return info
 
     if path.suffix == ".json":
-        data = json.loads(path.read_text())
-        data["info"] = update(dict(data.get("info", {})))
-        path.write_text(json.dumps(data, indent=2) + "\n")
+        search = FrameSearch.load(path)
+        replace(search, info=update(dict(search.info))).save(path)
     else:
         state = torch.load(path, map_location="cpu", weights_only=False)
         state["info"] = update(dict(state.get("info", {})))
@@ -177,7 +180,6 @@ def relabel(path: Path, release: str, digests: dict[str, str]) -> None:
 def ship(plan: ShipPlan, release: str) -> None:
     """Carry out a :func:`plan_ship` (module docstring, steps 2-3)."""
     names = role_files(plan.skill)
-    digests = {role: sha256(plan.source / names[role]) for role in ROLES if (plan.source / names[role]).exists()}
     plan.keep_dir.mkdir(parents=True)
     for path in plan.to_keep:
         shutil.move(str(path), plan.keep_dir / path.name)
@@ -186,7 +188,7 @@ def ship(plan: ShipPlan, release: str) -> None:
     for fitted in ("model", "frames", "searched"):
         path = plan.weights_dir / names[fitted]
         if path.exists() and (plan.source / names[fitted]).exists():
-            relabel(path, release, digests)
+            relabel(path, release, plan.digests)
 
 
 def main(argv: list[str] | None = None) -> int:
