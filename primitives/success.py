@@ -17,7 +17,10 @@ planner, which asks it often. Choices and why:
   outcomes better than its members (their errors differ), at K times the query cost of the nets,
   which is small beside the policy's decision.
 - **Data** are greedy rollouts of the policy on the procedural training split (85 % with a random
-  parameter, 15 % the seed's objective); physics-guard failures are dropped as in training.
+  parameter, 15 % the seed's objective); physics-guard failures are dropped as in training. With
+  ``--contrast K`` each start is executed in K of the goal frames its request leaves free
+  (:func:`collect_contrast`), so the model sees one start succeed in some frames and fail in others: what a
+  frame search (:mod:`primitives.frames`) asks of it is to rank one start's frames.
 - **Calibration.** After fitting (binary cross-entropy), Platt scaling (``sigmoid(a z + b)``) is fitted
   on rollouts from held-out *training* objects; figures are reported on the procedural *test* split,
   never seen by the policy or the model: ECE over 10 equal-width bins, Brier score, AUROC.
@@ -46,6 +49,7 @@ from primitives.networks import HybridActorCritic
 
 WEIGHTS_DIR = Path(__file__).parent / "weights"
 N_DECISION = 13  # policy-decision features, see decision_features
+CONTRAST_TURNS = 12  # turns about the vertical of frame-contrast rollouts, as the shipped frame searches try
 
 
 def decision_features(policy: HybridActorCritic, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
@@ -169,31 +173,50 @@ class Rollouts:
                                                         for r in parts))))
 
 
+class _RolloutRows:
+    """Rollouts as a collector gathers them, one valid rollout at a time (:meth:`add`), then :meth:`rollouts`."""
+
+    def __init__(self):
+        self.obs, self.decision, self.success, self.group, self.parameterised = [], [], [], [], []
+
+    def __len__(self) -> int:
+        return len(self.success)
+
+    def add(self, obs: np.ndarray, decision: np.ndarray, success: bool, object_key, parameterised: bool) -> None:
+        """One rollout: the observation acted on ``(N, 9)``, the decision features ``(13,)``, its outcome, the
+        object it was on (grouped by a stable hash of the key, for splits by object) and whether it had a
+        parameter."""
+        self.obs.append(obs.astype(np.float16))
+        self.decision.append(decision)
+        self.success.append(success)
+        self.group.append(zlib.crc32(repr(object_key).encode()))
+        self.parameterised.append(parameterised)
+
+    def rollouts(self) -> Rollouts:
+        return Rollouts(np.stack(self.obs), np.stack(self.decision).astype(np.float32), np.array(self.success),
+                        np.array(self.group), np.array(self.parameterised))
+
+
 @torch.no_grad()
 def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train", n_objects: int = 500,
             seed: int = 0, p_params: float = 0.85, progress: bool = True) -> Rollouts:
     """``n`` valid greedy rollouts of ``policy`` on a procedural split."""
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
-    obs_l, dec_l, succ_l, group_l, par_l = [], [], [], [], []
+    rows = _RolloutRows()
     bar = tqdm(total=n, desc=f"rollouts {skill} ({split})", disable=not progress, unit="rollout", mininterval=2.0)
-    while len(succ_l) < n:
+    while len(rows) < n:
         obs = env.reset()
         x = torch.from_numpy(obs)[None]
         idx, motion, dec = decision_features(policy, x)
         res = env.step(int(idx[0]), motion[0].numpy().astype(np.float64))
         if not res.valid:
             continue
-        obs_l.append(obs.astype(np.float16))
-        dec_l.append(dec[0].numpy())
-        succ_l.append(res.success)
-        group_l.append(zlib.crc32(repr(env.object_key).encode()))
-        par_l.append(res.params is not None)
+        rows.add(obs, dec[0].numpy(), res.success, env.object_key, res.params is not None)
         bar.update(1)
     bar.close()
     env.close()
-    return Rollouts(np.stack(obs_l), np.stack(dec_l).astype(np.float32), np.array(succ_l), np.array(group_l),
-                    np.array(par_l))
+    return rows.rollouts()
 
 
 @torch.no_grad()
@@ -210,10 +233,10 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
     from primitives.evaluate import greedy_action
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
-    rating, obs_l, dec_l, succ, group, par = [], [], [], [], [], []
+    rating, rows = [], _RolloutRows()
     bar = tqdm(total=n, desc=f"frame-search rollouts {skill} ({split})", disable=not progress, unit="rollout",
                mininterval=2.0)
-    while len(succ) < n:
+    while len(rows) < n:
         obs = env.reset()
         env.seen, p = search.select(skill, env.seen, model.predict, env.sim)
         idx, motion, _ = greedy_action(model.policy, env.seen.obs)
@@ -221,16 +244,63 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
         if not res.valid:
             continue
         rating.append(p)
-        obs_l.append(obs.astype(np.float16))
-        dec_l.append(decision_features(model.policy, torch.from_numpy(obs)[None])[2][0].numpy())
-        succ.append(res.success)
-        group.append(zlib.crc32(repr(env.object_key).encode()))
-        par.append(res.params is not None)
+        rows.add(obs, decision_features(model.policy, torch.from_numpy(obs)[None])[2][0].numpy(), res.success,
+                 env.object_key, res.params is not None)
         bar.update(1)
     bar.close()
     env.close()
-    return np.array(rating), Rollouts(np.stack(obs_l), np.stack(dec_l).astype(np.float32), np.array(succ),
-                                      np.array(group), np.array(par))
+    return np.array(rating), rows.rollouts()
+
+
+@torch.no_grad()
+def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_start: int, split: str = "train",
+                     n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
+                     progress: bool = True) -> Rollouts:
+    """``n`` valid greedy rollouts of ``policy``, ``per_start`` from each start: the start seen in that many of the
+    free frames of its request (``search.frames``, drawn without replacement), each executed from the same
+    simulator state (*frame-contrast* rollouts).
+
+    A frame search acts in the frame its success model rates likeliest, so what it needs from the model is a
+    ranking of one start's frames. Goal-frame rollouts show each start once (:func:`collect`); these show the
+    model the same start succeeding in some frames and failing in others. Every rollout is still a greedy
+    rollout of the policy on a start it could meet in the goal frame (each free frame is one, primitives.frames),
+    so the model keeps its meaning, ``P(success | observation)``, and its calibration.
+    """
+    import mujoco
+
+    from primitives import rewards
+    from primitives.frames import reframe
+
+    env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
+                                 episodes_per_object=4), seed=seed)
+    rng = np.random.default_rng([seed, 1])  # the frames drawn; apart from the environment's own stream
+    rows = _RolloutRows()
+    bar = tqdm(total=n, desc=f"frame-contrast rollouts {skill} ({split})", disable=not progress, unit="rollout",
+               mininterval=2.0)
+    while len(rows) < n:
+        env.reset()
+        sim, seen = env.sim, env.seen
+        start = mujoco.MjData(sim.model)
+        mujoco.mj_copyData(start, sim.model, sim.data)
+        frames = search.frames(skill, seen.params)
+        for j in rng.choice(len(frames), size=min(per_start, len(frames)), replace=False):
+            if len(rows) == n:
+                break
+            mujoco.mj_copyData(sim.data, sim.model, start)
+            framed = reframe(seen, frames[j])
+            idx, motion, dec = decision_features(policy, torch.from_numpy(framed.obs)[None])
+            i = int(idx[0])
+            out = sim.execute(framed.points[i], framed.motion_to_world(motion[0].numpy().astype(np.float64)),
+                              normal=framed.normals[i])
+            if not out.valid:
+                continue
+            rows.add(framed.obs, dec[0].numpy(),
+                     bool(rewards.success(skill, out.pose_before, out.pose_after, seen.params, sim.obj)),
+                     env.object_key, seen.params is not None)
+            bar.update(1)
+    bar.close()
+    env.close()
+    return rows.rollouts()
 
 
 def worker_seed(seed: int, worker: int) -> int:
@@ -245,10 +315,11 @@ def _collect_share(fn, args: tuple, kwargs: dict):
 
 
 def collect_parallel(fn, args: tuple, n: int, seed: int, workers: int = 1, progress: bool = True, **kwargs):
-    """``fn(*args, n_w, seed=worker_seed(seed, w), progress=..., **kwargs)`` (:func:`collect` or
-    :func:`collect_frame_search`) for ``w < workers`` in as many processes, their shares of ``n`` adding up to
-    ``n``; returns the shares' results in worker order. ``workers=1`` runs in this process. A given
-    ``(seed, workers)`` collects the same rollouts every time; another ``workers`` collects others."""
+    """``fn(*args, n_w, seed=worker_seed(seed, w), progress=..., **kwargs)`` (:func:`collect`,
+    :func:`collect_contrast` or :func:`collect_frame_search`) for ``w < workers`` in as many processes, their
+    shares of ``n`` adding up to ``n``; returns the shares' results in worker order. ``workers=1`` runs in this
+    process. A given ``(seed, workers)`` collects the same rollouts every time; another ``workers`` collects
+    others."""
     if workers < 1:
         raise InputError(f"workers must be a positive integer, got {workers}")
     shares = [n // workers + (w < n % workers) for w in range(workers)]
@@ -535,6 +606,12 @@ def build_parser() -> argparse.ArgumentParser:
     sub.choices["train"].add_argument("--views", action="store_true",
                                       help="with --frames: train on every rollout in each frame the search tries "
                                            "(its outcome is the same in all; FrameViews)")
+    sub.choices["train"].add_argument("--contrast", type=int, default=0, metavar="K",
+                                      help="frame-contrast rollouts (collect_contrast): execute each start in K of "
+                                           "the free frames of its request (12 turns about the vertical and the "
+                                           "mirror, where free), so the model learns to rank one start's frames "
+                                           "as a frame search asks it to; --rollouts counts them all "
+                                           "(default: 0, one goal-frame rollout per start)")
     sub.choices["train"].add_argument("--model", default=None,
                                       help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
@@ -551,6 +628,10 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--rollouts must be a positive integer, got {args.rollouts}")
     if getattr(args, "views", False) and args.frames is None:
         parser.error("--views needs --frames")
+    if getattr(args, "contrast", 0) < 0:
+        parser.error(f"--contrast must be a whole number >= 0, got {args.contrast}")
+    if getattr(args, "contrast", 0) and args.frames is not None:
+        parser.error("--contrast trains a goal-frame success model; --frames a searched one: give one")
     if getattr(args, "workers", 1) < 1:
         parser.error(f"--workers must be a positive integer, got {args.workers}")
     if getattr(args, "members", 1) < 1:
@@ -577,9 +658,17 @@ def _run(args: argparse.Namespace) -> int:
         searched = args.frames is not None
         search = _load_frame_search(args.skill, args.frames) if searched else None
         workers = f"_w{args.workers}" if args.workers > 1 else ""
-        cache = out / f"train_{'searched_' if searched else ''}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
+        kind = "searched_" if searched else f"contrast{args.contrast}_" if args.contrast else ""
+        cache = out / f"train_{kind}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
         if cache.exists():
             data = Rollouts.load(cache)
+        elif args.contrast:
+            from primitives.frames import FrameSearch
+
+            data = Rollouts.concat(collect_parallel(
+                collect_contrast, (policy, args.skill), args.rollouts, args.seed, args.workers,
+                progress=not args.json, search=FrameSearch(CONTRAST_TURNS, mirror=True), per_start=args.contrast,
+                split="train"))
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model))
             data = Rollouts.concat([part[1] for part in collect_parallel(
@@ -596,9 +685,12 @@ def _run(args: argparse.Namespace) -> int:
                     policy=args.policy or "shipped")
         if searched:
             info.update(frames=args.frames, model=args.model or "shipped")
+        if args.contrast:
+            info.update(contrast=args.contrast)
         info["command"] = ("python -m primitives.success train " + args.skill
                            + (f" --policy {args.policy}" if args.policy else "") + f" --rollouts {args.rollouts} "
                            f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
+                           + (f" --contrast {args.contrast}" if args.contrast else "")
                            + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
                            + (f" --model {args.model}" if searched and args.model else "")
                            + (f" --workers {args.workers}" if args.workers > 1 else ""))

@@ -173,3 +173,65 @@ def test_frames_command_calibrates_the_stand_ins_on_seed_objective_rollouts(tmp_
     assert "multiple of turns" in capsys.readouterr().err and not (tmp_path / "b").exists()  # nothing written
     with pytest.raises(SystemExit):
         success.main(["frames", "push", "--stand-ins", "24", "--stand-in-rollouts", "0"])
+
+
+def test_frame_contrast_rollouts_execute_one_start_in_several_frames():
+    """``collect_contrast``: each start is restored and executed once per drawn frame; the stored observation is
+    the start seen in that frame, with the policy's decision there."""
+    from primitives.frames import FrameSearch, reframe_obs
+    from primitives.skills import load_skill
+
+    policy = load_skill("spin", frame_search=False).success_model.policy
+    search = FrameSearch(4, False)
+    data = success.collect_contrast(policy, "spin", 6, search, 3, "train", n_objects=3, seed=1, p_params=1.0,
+                                    progress=False)
+    assert len(data) == 6 and data.parameterised.all()
+    assert data.group[0] == data.group[1] == data.group[2]  # one start, three frames
+    obs = data.obs.astype(np.float32)
+    turned = reframe_obs(obs[0], search.frames("spin", {}))  # the first start in each of the four frames
+    for i in (1, 2):
+        assert not np.allclose(obs[i], obs[0], atol=1e-2)  # frames drawn without replacement
+        assert min(np.abs(t - obs[i]).max() for t in turned) < 2e-3  # fp16-stored clouds
+    _, _, decision = success.decision_features(policy, torch.from_numpy(obs))
+    assert torch.allclose(decision, torch.from_numpy(data.decision), atol=0.05)
+    again = success.collect_contrast(policy, "spin", 6, search, 3, "train", n_objects=3, seed=1, p_params=1.0,
+                                     progress=False)
+    assert np.array_equal(again.obs, data.obs) and np.array_equal(again.success, data.success)
+
+
+class _Twice:
+    """A stand-in frame search whose 'free frames' are the goal frame twice."""
+
+    def frames(self, skill, params):
+        return np.stack([np.eye(3), np.eye(3)])
+
+
+def test_frame_contrast_rollouts_restore_the_start_before_each_frame():
+    """The same frame twice from one start: the same outcome both times, and the outcome one goal-frame rollout
+    of the same start has (the start is restored, not left where the first try moved it)."""
+    from primitives.skills import load_skill
+
+    policy = load_skill("spin", frame_search=False).success_model.policy
+    data = success.collect_contrast(policy, "spin", 8, _Twice(), 2, "train", n_objects=3, seed=5, p_params=1.0,
+                                    progress=False)
+    plain = success.collect(policy, "spin", 4, "train", n_objects=3, seed=5, p_params=1.0, progress=False)
+    assert np.array_equal(data.obs[0::2], data.obs[1::2]) and np.array_equal(data.success[0::2], data.success[1::2])
+    assert np.array_equal(data.obs[0::2], plain.obs) and np.array_equal(data.success[0::2], plain.success)
+    assert data.success.any()  # a spin that succeeded moved the object: the second try started over
+
+
+def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
+    """``success train SKILL --contrast K``: the rollouts are frame-contrast ones (cached under their own name), and
+    the model file records how it was made; ``--contrast`` with ``--frames`` or below 0 is refused."""
+    rc = success.main(["train", "spin", "--contrast", "3", "--rollouts", "30", "--epochs", "1", "--seed", "1",
+                       "--out", str(tmp_path), "--json"])
+    assert rc == 0
+    info = torch.load(tmp_path / "success.pt", weights_only=False)["info"]
+    assert info["contrast"] == 3 and "--rollouts 30 --seed 1 --epochs 1 --members 1 --contrast 3" in info["command"]
+    data = success.Rollouts.load(tmp_path / "train_contrast3_rollouts_30_1.npz")
+    assert len(data) == 30 == info["train"] + info["calibration"]
+    assert len(np.unique(data.group)) < 30  # several rollouts per start
+    for bad in (["--contrast", "3", "--frames", "shipped"], ["--contrast", "-1"]):
+        with pytest.raises(SystemExit):
+            success.main(["train", "spin", *bad, "--out", str(tmp_path / "no")])
+    assert not (tmp_path / "no").exists()
