@@ -268,7 +268,6 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     """
     import mujoco
 
-    from primitives import rewards
     from primitives.frames import reframe
 
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
@@ -287,16 +286,12 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
             if len(rows) == n:
                 break
             mujoco.mj_copyData(sim.data, sim.model, start)
-            framed = reframe(seen, frames[j])
-            idx, motion, dec = decision_features(policy, torch.from_numpy(framed.obs)[None])
-            i = int(idx[0])
-            out = sim.execute(framed.points[i], framed.motion_to_world(motion[0].numpy().astype(np.float64)),
-                              normal=framed.normals[i])
-            if not out.valid:
+            env.seen = reframe(seen, frames[j])  # what env.step executes and judges (as collect_frame_search)
+            idx, motion, dec = decision_features(policy, torch.from_numpy(env.seen.obs)[None])
+            res = env.step(int(idx[0]), motion[0].numpy().astype(np.float64))
+            if not res.valid:
                 continue
-            rows.add(framed.obs, dec[0].numpy(),
-                     bool(rewards.success(skill, out.pose_before, out.pose_after, seen.params, sim.obj)),
-                     env.object_key, seen.params is not None)
+            rows.add(env.seen.obs, dec[0].numpy(), res.success, env.object_key, res.params is not None)
             bar.update(1)
     bar.close()
     env.close()
