@@ -165,38 +165,62 @@ class FrameSearch:
         """Whether a request ``params`` of ``skill`` leaves this search more than one option to rate."""
         return len(self.frames(skill, params)) > 1 or self.tries_stand_ins(params)
 
+    def options(self, skill: str, seen: SkillObservation, sim: Simulator) -> list[tuple[SkillObservation, np.ndarray]]:
+        """What this search rates for ``seen`` (of ``sim``'s current cloud): pairs of an observation and its free
+        frames ``(m, 3, 3)``, the request itself first, then for the seed's objective with stand-ins each stand-in
+        request (:func:`stand_in_requests`) observed on the same cloud."""
+        options = [(seen, self.frames(skill, seen.params))]
+        if self.tries_stand_ins(seen.params):
+            T_world_object = sim.object_pose()
+            state = sim.obj.classify(T_world_object)
+            for request in stand_in_requests(skill, self.stand_ins, sim.obj, state):
+                request = skill_params.check(skill, request, sim.obj, state)
+                asked = observe_cloud(sim.obj, skill, request, seen.points, seen.normals, T_world_object)
+                options.append((asked, self.frames(skill, request)))
+        return options
+
+    def choose(self, options: list[tuple[SkillObservation, np.ndarray]],
+               ratings: list[np.ndarray]) -> tuple[int, int, float]:
+        """The option and frame to act in, ``(k, j)``, given each option's ratings (one per frame), and its score:
+        the best raw rating of the one option, or among several the option whose best rating, calibrated for its
+        kind, is highest (module docstring), and that calibrated rating."""
+        best = [int(np.argmax(q)) for q in ratings]
+        if len(options) == 1:
+            return 0, best[0], float(ratings[0][best[0]])
+        score = [float(self.calibrate_kind(q[b], option.params is not None)) for q, b, (option, _) in
+                 zip(ratings, best, options)]
+        k = int(np.argmax(score))
+        return k, best[k], score[k]
+
+    @staticmethod
+    def acting(options: list[tuple[SkillObservation, np.ndarray]], k: int, j: int) -> SkillObservation:
+        """The observation a skill acts on in option ``k``'s frame ``j``: the first option's request, or a stand-in
+        request's observation with ``params`` ``None`` (the outcome is judged by the seed's objective) and
+        ``acted_as`` naming the request."""
+        option, frames = options[k]
+        chosen = reframe(option, frames[j])
+        return replace(chosen, params=None, acted_as=option.params) if k else chosen
+
     def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator) -> tuple[SkillObservation, float]:
         """The observation to act on and its score: ``seen`` (of ``sim``'s current cloud) in the free frame, or
         for the seed's objective with stand-ins the free frame of the stand-in request, that ``predict``
-        (observations ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch.
+        (observations ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch
+        (:meth:`options`, :meth:`choose`).
 
         The returned observation keeps ``seen.params`` (what the outcome is judged by); ``acted_as`` names the
         stand-in request where one was chosen. The score is the best raw rating, or with stand-ins the best rating
         calibrated for its kind (module docstring); :meth:`calibrate` it with ``seen.params is not None``.
         """
-        frames = self.frames(skill, seen.params)
         if not self.tries_stand_ins(seen.params):
-            return select_frame(seen, predict, frames)
-        options = [(seen, frames)]
-        T_world_object = sim.object_pose()
-        state = sim.obj.classify(T_world_object)
-        for request in stand_in_requests(skill, self.stand_ins, sim.obj, state):
-            request = skill_params.check(skill, request, sim.obj, state)
-            asked = observe_cloud(sim.obj, skill, request, seen.points, seen.normals, T_world_object)
-            options.append((asked, self.frames(skill, request)))
+            return select_frame(seen, predict, self.frames(skill, seen.params))
+        options = self.options(skill, seen, sim)
         p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])))
-        per_option = np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
-        best = [int(np.argmax(q)) for q in per_option]
-        score = [float(self._platt(q[b], option.params is not None)) for q, b, (option, _) in
-                 zip(per_option, best, options)]
-        k = int(np.argmax(score))
-        option, option_frames = options[k]
-        chosen = reframe(option, option_frames[best[k]])
-        if k:
-            chosen = replace(chosen, params=None, acted_as=option.params)
-        return chosen, score[k]
+        k, j, score = self.choose(options, np.split(p, np.cumsum([len(f) for _, f in options])[:-1]))
+        return self.acting(options, k, j), score
 
-    def _platt(self, p: np.ndarray | float, parameterised: np.ndarray | bool) -> np.ndarray:
+    def calibrate_kind(self, p: np.ndarray | float, parameterised: np.ndarray | bool) -> np.ndarray:
+        """The best rating ``p`` of an option calibrated for its kind: ``platt`` for a request with a parameter,
+        ``platt_unparameterised`` for the seed's own observation (the scale :meth:`choose` compares options on)."""
         (a, b), (a0, b0) = self.platt, self.platt_unparameterised
         par = np.asarray(parameterised, dtype=bool)
         return expit(np.where(par, a, a0) * rating_logit(p) + np.where(par, b, b0))
@@ -205,9 +229,9 @@ class FrameSearch:
         """The calibrated probability of the scores ``p`` (:meth:`select`) of requests with (or without) a
         parameter; ``parameterised`` is one flag for all, or one per score."""
         if not self.stand_ins:
-            return self._platt(p, parameterised)
+            return self.calibrate_kind(p, parameterised)
         a, b = self.platt_stand_ins
-        return np.where(parameterised, self._platt(p, True), expit(a * rating_logit(p) + b))
+        return np.where(parameterised, self.calibrate_kind(p, True), expit(a * rating_logit(p) + b))
 
     def save(self, path: str | os.PathLike) -> None:
         d = asdict(self)
@@ -225,3 +249,14 @@ class FrameSearch:
                        int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
+
+
+def load_frame_search(skill: str, frames: str | os.PathLike) -> FrameSearch:
+    """``"shipped"``: the frame search shipped beside ``skill``'s weights; else the frames.json at ``frames``.
+    Raises :class:`InputError` where none is shipped or the file is unreadable."""
+    from primitives.skills import shipped_frame_search
+
+    search = shipped_frame_search(skill) if str(frames) == "shipped" else FrameSearch.load(frames)
+    if search is None:
+        raise InputError(f"no frame search is shipped for {skill}")
+    return search

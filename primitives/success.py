@@ -45,6 +45,7 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
+from primitives.frames import load_frame_search
 from primitives.networks import HybridActorCritic
 
 WEIGHTS_DIR = Path(__file__).parent / "weights"
@@ -651,7 +652,7 @@ def _run(args: argparse.Namespace) -> int:
     policy = load_policy(args.policy, args.skill)
     if args.command == "train":
         searched = args.frames is not None
-        search = _load_frame_search(args.skill, args.frames) if searched else None
+        search = load_frame_search(args.skill, args.frames) if searched else None
         workers = f"_w{args.workers}" if args.workers > 1 else ""
         kind = "searched_" if searched else f"contrast{args.contrast}_" if args.contrast else ""
         cache = out / f"train_{kind}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
@@ -757,23 +758,13 @@ def _run_frames(args: argparse.Namespace) -> int:
     return 0
 
 
-def _load_frame_search(skill: str, frames: str):
-    from primitives.frames import FrameSearch
-    from primitives.skills import shipped_frame_search
-
-    search = shipped_frame_search(skill) if frames == "shipped" else FrameSearch.load(frames)
-    if search is None:
-        raise InputError(f"no frame search is shipped for {skill}")
-    return search
-
-
 def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
     """``evaluate --frames``: the skill acting with a frame search on unseen objects, judged by two raters on the
     same rollouts: the calibrated rating of the chosen frame, and the searched success model, which rates the
     searched skill from the goal frame alone (the shipped ``{skill}_success_searched.pt``, or ``--searched``)."""
     from primitives.frames import reframe_obs
 
-    search = _load_frame_search(args.skill, args.frames)
+    search = load_frame_search(args.skill, args.frames)
     rating, data = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
                                         seed=args.seed, progress=not args.json)
     success, par = data.success, data.parameterised

@@ -1,0 +1,215 @@
+"""How much could a frame search gain? Every option it rates, executed from the same start.
+
+    python -m primitives.frame_ceiling spin --starts 100 --params random
+    python -m primitives.frame_ceiling push --starts 100 --params none --json --plot push_frame_ceiling.png
+
+A frame search (:mod:`primitives.frames`) sees a start in every frame its request leaves free (and, for the
+seed's objective, as each stand-in request) and acts in the option its success model rates likeliest. For each
+start of the evaluation (:func:`primitives.evaluate.evaluate`'s starts for the same ``--seed``), this benchmark
+restores the simulator to the start before executing the policy in *every* option, and reports the success of
+
+- **goal frame**: the policy as trained, no search;
+- **random option**: an option drawn at random (the mean over a start's options);
+- **critic's pick**: the option where the critic's value at its chosen contact is highest;
+- **search's pick**: the option the frame search acts in (the skill as shipped; the outcomes of
+  ``primitives.evaluate --frames`` on the same starts);
+- **best option**: some option succeeds, what a perfect ranking of the same options would reach;
+
+and how well the success model ranks one start's options: the **within-start AUROC** of the ratings (each
+option's rating calibrated for its kind, the scale the search compares on), averaged over the starts where
+some options succeed and others fail. The gap between the search's pick and the best option is what a better
+ranker could gain with the same policy; the gap between the best option and 1 is the policy's.
+
+Options are judged as the skill judges them: by the request, or by the seed's objective for a stand-in.
+The simulator state is restored with a MuJoCo state copy; the finger pusher the primitives act with keeps no
+state outside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from affordplan.errors import AffordplanError
+from primitives.env import PRIMITIVES, PrimitiveEnv
+from primitives.evaluate import greedy_action, held_out_config, load_policy
+from primitives.frames import FrameSearch, load_frame_search, reframe_obs
+from primitives.networks import HybridActorCritic
+from primitives.success import auroc
+
+
+@dataclass(frozen=True)
+class StartOptions:
+    """Every option of one start, in the order :meth:`FrameSearch.options` lists them (the goal frame first).
+
+    ``option``: the option each row belongs to (0: the request itself, ``k > 0``: the k-th stand-in); ``frame``:
+    its frame's index in that option; ``rating``: the success model's rating calibrated for its kind
+    (:meth:`FrameSearch.calibrate_kind`); ``q_max``: the critic's value at the policy's contact; ``success``: the
+    outcome of executing it from the start; ``pick``: the row the search acts in.
+    """
+
+    params: dict | None
+    option: np.ndarray
+    frame: np.ndarray
+    rating: np.ndarray
+    q_max: np.ndarray
+    success: np.ndarray
+    pick: int
+
+    @property
+    def mixed(self) -> bool:
+        """Whether some options succeed and others fail."""
+        return bool(self.success.any() and not self.success.all())
+
+
+@dataclass
+class FrameCeiling:
+    """The options of each start (:class:`StartOptions`) and the figures of the module docstring."""
+
+    skill: str
+    params: str
+    starts: list[StartOptions]
+
+    def rates(self) -> dict[str, float]:
+        s = self.starts
+        return {"goal frame": float(np.mean([o.success[0] for o in s])),
+                "random option": float(np.mean([o.success.mean() for o in s])),
+                "critic's pick": float(np.mean([o.success[np.argmax(o.q_max)] for o in s])),
+                "search's pick": float(np.mean([o.success[o.pick] for o in s])),
+                "best option": float(np.mean([o.success.any() for o in s]))}
+
+    def within_start_auroc(self) -> float | None:
+        """The model's AUROC within one start's options, averaged over the mixed starts (None without any)."""
+        values = [auroc(o.rating, o.success) for o in self.starts if o.mixed]
+        return float(np.mean(values)) if values else None
+
+    def as_dict(self) -> dict:
+        return dict(skill=self.skill, params=self.params, starts=len(self.starts),
+                    options_per_start=float(np.mean([len(o.success) for o in self.starts])),
+                    success=self.rates(), mixed_share=float(np.mean([o.mixed for o in self.starts])),
+                    within_start_auroc=self.within_start_auroc())
+
+    def report(self) -> str:
+        d = self.as_dict()
+        lines = [f"{self.skill}, params {self.params}: {d['starts']} held-out starts, "
+                 f"{d['options_per_start']:.1f} options each, every one executed from the start"]
+        lines += [f"  {name:<15} {rate:.3f}" for name, rate in d["success"].items()]
+        auc = d["within_start_auroc"]
+        lines.append(f"  some options succeed and others fail on {d['mixed_share']:.2f} of the starts; the "
+                     f"success model ranks them with a within-start AUROC of "
+                     + ("n/a" if auc is None else f"{auc:.3f}"))
+        return "\n".join(lines)
+
+    def plot(self, path) -> None:
+        """A bar chart of :meth:`rates`."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        rates = self.rates()
+        fig, ax = plt.subplots(figsize=(6, 3.6))
+        colours = ["#bbbbbb", "#bbbbbb", "#8fb3d9", "#d98c2b", "#5a9e5a"]
+        bars = ax.bar(range(len(rates)), list(rates.values()), color=colours)
+        ax.bar_label(bars, fmt="%.2f")
+        ax.set_xticks(range(len(rates)), list(rates), rotation=15)
+        ax.set_ylim(0, 1.05)
+        ax.set_ylabel("success rate")
+        ax.set_title(f"{self.skill} ({self.params}): the same options, picked four ways ({len(self.starts)} starts)")
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+
+
+@torch.no_grad()
+def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSearch, predict) -> StartOptions:
+    """Execute every option of ``search`` on ``env``'s current start, restoring the start before each (and after
+    the last)."""
+    skill, sim, seen = env.config.primitive, env.sim, env.seen
+    start = mujoco.MjData(sim.model)
+    mujoco.mj_copyData(start, sim.model, sim.data)
+    options = search.options(skill, seen, sim)
+    raw = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
+    ratings = np.split(raw, np.cumsum([len(f) for _, f in options])[:-1])
+    k_pick, j_pick, _ = search.choose(options, ratings)
+    option, frame, q_max, success = [], [], [], []
+    for k, (_, frames) in enumerate(options):
+        for j in range(len(frames)):
+            mujoco.mj_copyData(sim.data, sim.model, start)
+            env.seen = search.acting(options, k, j)
+            idx, motion, q = greedy_action(policy, env.seen.obs)
+            success.append(env.step(idx, motion).success)
+            option.append(k), frame.append(j), q_max.append(float(q[idx]))
+    mujoco.mj_copyData(sim.data, sim.model, start)
+    env.seen = seen
+    option, frame = np.array(option), np.array(frame)
+    parameterised = np.array([options[k][0].params is not None for k in option])
+    return StartOptions(seen.params, option, frame, search.calibrate_kind(raw, parameterised), np.array(q_max),
+                        np.array(success, dtype=bool), int(np.flatnonzero((option == k_pick) & (frame == j_pick))[0]))
+
+
+def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: int = 1234,
+                  weights=None, model=None, frames: str = "shipped", progress: bool = True) -> FrameCeiling:
+    """Every option of ``starts`` held-out starts of ``skill`` (``params``: ``"random"`` asks for a random
+    parameter, ``"none"`` the seed's objective), with the policy ``weights``, the success model ``model`` and the
+    frame search ``frames`` (``"shipped"`` or a frames.json path; defaults: the shipped ones)."""
+    from primitives.success import SuccessModel, load_success_net
+
+    policy = load_policy(weights, skill)
+    predict = SuccessModel(policy, load_success_net(skill, model)).predict
+    search = load_frame_search(skill, frames)
+    env = PrimitiveEnv(held_out_config(skill, 1.0 if params == "random" else 0.0), seed=seed)
+    out = FrameCeiling(skill, params, [])
+    for _ in tqdm(range(starts), desc=f"{skill} frame ceiling", disable=not progress, unit="start", mininterval=2.0):
+        env.reset()
+        out.starts.append(start_options(env, policy, search, predict))
+    env.close()
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m primitives.frame_ceiling", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n  python -m primitives.frame_ceiling spin --starts 100 --params random\n"
+               "  python -m primitives.frame_ceiling push --starts 100 --params none --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("skill", choices=PRIMITIVES)
+    p.add_argument("--starts", type=int, default=100, help="held-out starts (default: 100)")
+    p.add_argument("--params", choices=["none", "random"], default="random",
+                   help="random: each start asks for a random parameter; none: the seed's objective")
+    p.add_argument("--seed", type=int, default=1234, help="the evaluation's seed: same starts (default: 1234)")
+    p.add_argument("--weights", default=None, help="policy (default: shipped)")
+    p.add_argument("--model", default=None, help="goal-frame success model rating the options (default: shipped)")
+    p.add_argument("--frames", default="shipped", metavar="shipped|PATH", help="frame search (default: shipped)")
+    p.add_argument("--plot", default=None, help="bar chart PNG")
+    p.add_argument("--json", action="store_true")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.starts < 1:
+        parser.error(f"--starts must be a positive integer, got {args.starts}")
+    torch.set_num_threads(1)
+    try:
+        result = frame_ceiling(args.skill, args.starts, args.params, args.seed, args.weights, args.model,
+                               args.frames, progress=not args.json)
+    except AffordplanError as exc:  # missing or broken weights, an unreadable frames file, ...
+        print(f"primitives.frame_ceiling: error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
+    if args.plot:
+        result.plot(args.plot)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
