@@ -258,14 +258,16 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
                      n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
                      progress: bool = True) -> Rollouts:
     """``n`` valid greedy rollouts of ``policy``, ``per_start`` from each start: the start seen in that many of the
-    free frames of its request (``search.frames``, drawn without replacement), each executed from the same
-    simulator state (*frame-contrast* rollouts).
+    options ``search`` rates for its request (:meth:`primitives.frames.FrameSearch.options`: its free frames, and
+    for the seed's objective with stand-ins each stand-in request in its own free frames), drawn without
+    replacement, each executed from the same simulator state (*frame-contrast* rollouts).
 
-    A frame search acts in the frame its success model rates likeliest, so what it needs from the model is a
-    ranking of one start's frames. Goal-frame rollouts show each start once (:func:`collect`); these show the
-    model the same start succeeding in some frames and failing in others. Every rollout is still a greedy
-    rollout of the policy on a start it could meet in the goal frame (each free frame is one, primitives.frames),
-    so the model keeps its meaning, ``P(success | observation)``, and its calibration.
+    A frame search acts in the option its success model rates likeliest, so what it needs from the model is a
+    ranking of one start's options. Goal-frame rollouts show each start once (:func:`collect`); these show the
+    model the same start succeeding in some options and failing in others. Every rollout is still a greedy
+    rollout of the policy on a start it could meet with that request (each free frame is one, primitives.frames),
+    judged by that request's criterion (a stand-in request's own, not the seed's), so the model keeps its
+    meaning, ``P(success | observation)``, and its calibration.
     """
     import mujoco
 
@@ -273,21 +275,21 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
 
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
-    rng = np.random.default_rng([seed, 1])  # the frames drawn; apart from the environment's own stream
+    rng = np.random.default_rng([seed, 1])  # the options drawn; apart from the environment's own stream
     rows = _RolloutRows()
     bar = tqdm(total=n, desc=f"frame-contrast rollouts {skill} ({split})", disable=not progress, unit="rollout",
                mininterval=2.0)
     while len(rows) < n:
         env.reset()
-        sim, seen = env.sim, env.seen
+        sim = env.sim
         start = mujoco.MjData(sim.model)
         mujoco.mj_copyData(start, sim.model, sim.data)
-        frames = search.frames(skill, seen.params)
-        for j in rng.choice(len(frames), size=min(per_start, len(frames)), replace=False):
+        options = [(asked, B) for asked, frames in search.options(skill, env.seen, sim) for B in frames]
+        for i in rng.choice(len(options), size=min(per_start, len(options)), replace=False):
             if len(rows) == n:
                 break
             mujoco.mj_copyData(sim.data, sim.model, start)
-            env.seen = reframe(seen, frames[j])  # what env.step executes and judges (as collect_frame_search)
+            env.seen = reframe(*options[i])  # what env.step executes and judges (as collect_frame_search)
             idx, motion, dec = decision_features(policy, torch.from_numpy(env.seen.obs)[None])
             res = env.step(int(idx[0]), motion[0].numpy().astype(np.float64))
             if not res.valid:
@@ -608,6 +610,11 @@ def build_parser() -> argparse.ArgumentParser:
                                            "mirror, where free), so the model learns to rank one start's frames "
                                            "as a frame search asks it to; --rollouts counts them all "
                                            "(default: 0, one goal-frame rollout per start)")
+    sub.choices["train"].add_argument("--contrast-stand-ins", type=int, default=0, metavar="N",
+                                      help="with --contrast: for starts with the seed's objective, also draw from "
+                                           "the stand-in requests a frame search with --stand-ins N tries (push: N "
+                                           "directions, a multiple of 12; spin, roll: any N > 0), each judged by its "
+                                           "own criterion (default: 0, the seed's own frames only)")
     sub.choices["train"].add_argument("--model", default=None,
                                       help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
@@ -628,6 +635,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--contrast must be a whole number >= 0, got {args.contrast}")
     if getattr(args, "contrast", 0) and args.frames is not None:
         parser.error("--contrast trains a goal-frame success model; --frames a searched one: give one")
+    if getattr(args, "contrast_stand_ins", 0) and not args.contrast:
+        parser.error("--contrast-stand-ins needs --contrast")
     if getattr(args, "workers", 1) < 1:
         parser.error(f"--workers must be a positive integer, got {args.workers}")
     if getattr(args, "members", 1) < 1:
@@ -647,6 +656,11 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.command == "frames":
         return _run_frames(args)
+    contrast = None  # the options a frame-contrast start is executed in (checks --contrast-stand-ins first)
+    if args.command == "train" and args.contrast:
+        from primitives.frames import FrameSearch
+
+        contrast = FrameSearch(CONTRAST_TURNS, mirror=True, stand_ins=args.contrast_stand_ins)
     out = Path(args.out or f"runs/{args.skill}_success")
     out.mkdir(parents=True, exist_ok=True)
     policy = load_policy(args.policy, args.skill)
@@ -654,17 +668,15 @@ def _run(args: argparse.Namespace) -> int:
         searched = args.frames is not None
         search = load_frame_search(args.skill, args.frames) if searched else None
         workers = f"_w{args.workers}" if args.workers > 1 else ""
-        kind = "searched_" if searched else f"contrast{args.contrast}_" if args.contrast else ""
+        stand_ins = f"s{args.contrast_stand_ins}" if args.contrast_stand_ins else ""
+        kind = "searched_" if searched else f"contrast{args.contrast}{stand_ins}_" if args.contrast else ""
         cache = out / f"train_{kind}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
         if cache.exists():
             data = Rollouts.load(cache)
-        elif args.contrast:
-            from primitives.frames import FrameSearch
-
+        elif contrast is not None:
             data = Rollouts.concat(collect_parallel(
                 collect_contrast, (policy, args.skill), args.rollouts, args.seed, args.workers,
-                progress=not args.json, search=FrameSearch(CONTRAST_TURNS, mirror=True), per_start=args.contrast,
-                split="train"))
+                progress=not args.json, search=contrast, per_start=args.contrast, split="train"))
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model))
             data = Rollouts.concat([part[1] for part in collect_parallel(
@@ -682,11 +694,12 @@ def _run(args: argparse.Namespace) -> int:
         if searched:
             info.update(frames=args.frames, model=args.model or "shipped")
         if args.contrast:
-            info.update(contrast=args.contrast)
+            info.update(contrast=args.contrast, contrast_stand_ins=args.contrast_stand_ins)
         info["command"] = ("python -m primitives.success train " + args.skill
                            + (f" --policy {args.policy}" if args.policy else "") + f" --rollouts {args.rollouts} "
                            f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
                            + (f" --contrast {args.contrast}" if args.contrast else "")
+                           + (f" --contrast-stand-ins {args.contrast_stand_ins}" if args.contrast_stand_ins else "")
                            + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
                            + (f" --model {args.model}" if searched and args.model else "")
                            + (f" --workers {args.workers}" if args.workers > 1 else ""))

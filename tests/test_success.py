@@ -5,6 +5,7 @@ import pytest
 import torch
 
 from primitives import success
+from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
 
 
@@ -178,7 +179,7 @@ def test_frames_command_calibrates_the_stand_ins_on_seed_objective_rollouts(tmp_
 def test_frame_contrast_rollouts_execute_one_start_in_several_frames():
     """``collect_contrast``: each start is restored and executed once per drawn frame; the stored observation is
     the start seen in that frame, with the policy's decision there."""
-    from primitives.frames import FrameSearch, reframe_obs
+    from primitives.frames import reframe_obs
     from primitives.skills import load_skill
 
     policy = load_skill("spin", frame_search=False).success_model.policy
@@ -199,8 +200,8 @@ def test_frame_contrast_rollouts_execute_one_start_in_several_frames():
     assert np.array_equal(again.obs, data.obs) and np.array_equal(again.success, data.success)
 
 
-class _Twice:
-    """A stand-in frame search whose 'free frames' are the goal frame twice."""
+class _Twice(FrameSearch):
+    """A frame search whose 'free frames' are the goal frame twice."""
 
     def frames(self, skill, params):
         return np.stack([np.eye(3), np.eye(3)])
@@ -212,7 +213,7 @@ def test_frame_contrast_rollouts_restore_the_start_before_each_frame():
     from primitives.skills import load_skill
 
     policy = load_skill("spin", frame_search=False).success_model.policy
-    data = success.collect_contrast(policy, "spin", 8, _Twice(), 2, "train", n_objects=3, seed=5, p_params=1.0,
+    data = success.collect_contrast(policy, "spin", 8, _Twice(turns=1), 2, "train", n_objects=3, seed=5, p_params=1.0,
                                     progress=False)
     plain = success.collect(policy, "spin", 4, "train", n_objects=3, seed=5, p_params=1.0, progress=False)
     assert np.array_equal(data.obs[0::2], data.obs[1::2]) and np.array_equal(data.success[0::2], data.success[1::2])
@@ -235,3 +236,30 @@ def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
         with pytest.raises(SystemExit):
             success.main(["train", "spin", *bad, "--out", str(tmp_path / "no")])
     assert not (tmp_path / "no").exists()
+
+
+def test_frame_contrast_rollouts_may_act_as_the_stand_in_requests():
+    """With a search that has stand-ins, a start with the seed's objective is also executed as if asked for each
+    drawn stand-in request, judged by that request's own criterion (a parameterised rollout); starts with a
+    parameter keep their own free frames."""
+    from primitives.frames import reframe_obs
+    from primitives.skills import load_skill
+
+    policy = load_skill("push", frame_search=False).success_model.policy
+    search = FrameSearch(2, True, stand_ins=4)  # the seed's 4 frames and 4 directions x 2 mirrors: 12 options
+    data = success.collect_contrast(policy, "push", 12, search, 12, "train", n_objects=3, seed=2, p_params=0.0,
+                                    progress=False)
+    assert len(np.unique(data.group)) == 1  # one start (one object), all twelve options
+    assert data.parameterised.sum() == 8  # the four directions in both mirrors, judged as asked
+    flows = np.abs(data.obs[:, :, 6:].astype(np.float32)).max(axis=(1, 2))
+    assert (flows[~data.parameterised] == 0).all() and (flows[data.parameterised] > 0).all()
+    seed_frames = data.obs[~data.parameterised].astype(np.float32)
+    turned = reframe_obs(seed_frames[0], search.frames("push", None))
+    assert all(min(np.abs(t - o).max() for t in turned) < 2e-3 for o in seed_frames)
+    asked = success.collect_contrast(policy, "push", 4, search, 12, "train", n_objects=3, seed=2, p_params=1.0,
+                                     progress=False)
+    assert asked.parameterised.all()
+    mirrored = reframe_obs(asked.obs[0].astype(np.float32), search.frames("push", {}))[1]
+    assert np.abs(mirrored - asked.obs[1]).max() < 2e-3  # a direction's options: its two mirror frames
+    with pytest.raises(SystemExit):
+        success.main(["train", "push", "--contrast-stand-ins", "24"])  # needs --contrast
