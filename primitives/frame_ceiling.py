@@ -122,7 +122,7 @@ class FrameCeiling:
         ax.set_xticks(range(len(rates)), list(rates), rotation=15)
         ax.set_ylim(0, 1.05)
         ax.set_ylabel("success rate")
-        ax.set_title(f"{self.skill} ({self.params}): the same options, picked four ways ({len(self.starts)} starts)")
+        ax.set_title(f"{self.skill}, params {self.params}: every option executed from {len(self.starts)} starts")
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)
