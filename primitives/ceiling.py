@@ -34,7 +34,6 @@ import math
 import sys
 from dataclasses import asdict, dataclass, field
 
-import mujoco
 import numpy as np
 import torch
 from tqdm import tqdm
@@ -137,15 +136,14 @@ def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, we
     for _ in tqdm(range(starts), desc="push ceiling", disable=not progress, unit="start", mininterval=2.0):
         obs = env.reset()
         sim, prm = env.sim, env.params
-        start = mujoco.MjData(sim.model)
-        mujoco.mj_copyData(start, sim.model, sim.data)
+        start = sim.snapshot()
         wins = 0
         cands = candidates_for(sim, prm, rng)
         for c in cands:
-            mujoco.mj_copyData(sim.data, sim.model, start)
+            sim.restore(start)
             out = sim.execute(c.contact, c.motion, normal=c.normal)
             wins += bool(out.valid and rewards.success("push", out.pose_before, out.pose_after, prm, sim.obj))
-        mujoco.mj_copyData(sim.data, sim.model, start)
+        sim.restore(start)
         idx, motion, _ = greedy_action(model, obs)
         policy_ok = env.step(idx, motion).success
         kind = sim.obj.name.rsplit("_", 1)[-1]

@@ -21,8 +21,7 @@ some options succeed and others fail. The gap between the search's pick and the 
 ranker could gain with the same policy; the gap between the best option and 1 is the policy's.
 
 Options are judged as the skill judges them: by the request, or by the seed's objective for a stand-in.
-The simulator state is restored with a MuJoCo state copy; the finger pusher the primitives act with keeps no
-state outside it.
+The simulator is restored with :meth:`Simulator.snapshot` / :meth:`Simulator.restore`.
 """
 
 from __future__ import annotations
@@ -32,7 +31,6 @@ import json
 import sys
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 import torch
 from tqdm import tqdm
@@ -133,8 +131,7 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     """Execute every option of ``search`` on ``env``'s current start, restoring the start before each (and after
     the last)."""
     skill, sim, seen = env.config.primitive, env.sim, env.seen
-    start = mujoco.MjData(sim.model)
-    mujoco.mj_copyData(start, sim.model, sim.data)
+    start = sim.snapshot()
     options = search.options(skill, seen, sim)
     raw = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
     ratings = np.split(raw, np.cumsum([len(f) for _, f in options])[:-1])
@@ -142,12 +139,12 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     option, frame, q_max, success = [], [], [], []
     for k, (_, frames) in enumerate(options):
         for j in range(len(frames)):
-            mujoco.mj_copyData(sim.data, sim.model, start)
+            sim.restore(start)
             env.seen = search.acting(options, k, j)
             idx, motion, q = greedy_action(policy, env.seen.obs)
             success.append(env.step(idx, motion).success)
             option.append(k), frame.append(j), q_max.append(float(q[idx]))
-    mujoco.mj_copyData(sim.data, sim.model, start)
+    sim.restore(start)
     env.seen = seen
     option, frame = np.array(option), np.array(frame)
     parameterised = np.array([options[k][0].params is not None for k in option])

@@ -269,8 +269,6 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     judged by that request's criterion (a stand-in request's own, not the seed's), so the model keeps its
     meaning, ``P(success | observation)``, and its calibration.
     """
-    import mujoco
-
     from primitives.frames import reframe
 
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
@@ -282,13 +280,12 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     while len(rows) < n:
         env.reset()
         sim = env.sim
-        start = mujoco.MjData(sim.model)
-        mujoco.mj_copyData(start, sim.model, sim.data)
+        start = sim.snapshot()
         options = [(asked, B) for asked, frames in search.options(skill, env.seen, sim) for B in frames]
         for i in rng.choice(len(options), size=min(per_start, len(options)), replace=False):
             if len(rows) == n:
                 break
-            mujoco.mj_copyData(sim.data, sim.model, start)
+            sim.restore(start)
             env.seen = reframe(*options[i])  # what env.step executes and judges (as collect_frame_search)
             idx, motion, dec = decision_features(policy, torch.from_numpy(env.seen.obs)[None])
             res = env.step(int(idx[0]), motion[0].numpy().astype(np.float64))

@@ -164,3 +164,27 @@ def test_motion_is_clipped_to_unit_box(cube):
     out = sim.execute(T0[:3, 3] - np.array([0.05, 0.0, 0.0]), (5.0, 0.0, 0.0))
     assert np.array_equal(out.motion, [1.0, 0.0, 0.0])
     assert out.pose_after[0, 3] - T0[0, 3] < 0.1
+
+
+def test_a_snapshot_lets_another_primitive_start_from_the_same_state(cube):
+    """Restore puts the cube back where the snapshot found it (exactly), so the same push does the same again and
+    a different one starts from the same place; a state from another simulator is refused."""
+    sim = ap.Simulator(cube)
+    start = sim.snapshot()
+    first = face_centre_push(sim, cube, stroke=2.0 / 3.0)
+    assert 0.04 <= rewards.motion(first.pose_before, first.pose_after).p[0] <= 0.09  # it moved
+    sim.restore(start)
+    T0 = sim.object_pose()
+    assert np.array_equal(T0, first.pose_before)
+    contact = T0[:3, 3] - np.array([cube.mesh.extents[0] / 2, 0.0, 0.0])
+    again = sim.execute(contact, (2.0 / 3.0, 0.0, 0.0))
+    assert np.array_equal(again.pose_before, first.pose_before) and np.array_equal(again.pose_after, first.pose_after)
+    sim.restore(start)
+    short = sim.execute(contact, (1.0 / 3.0, 0.0, 0.0))
+    assert np.array_equal(short.pose_before, first.pose_before)
+    assert rewards.motion(short.pose_before, short.pose_after).p[0] < rewards.motion(first.pose_before,
+                                                                                     first.pose_after).p[0]
+    with pytest.raises(InputError):
+        sim.restore("start")
+    with pytest.raises(InputError):
+        sim.restore(ap.Simulator(cube).snapshot())  # another simulator's, even of the same scene

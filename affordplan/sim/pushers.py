@@ -69,6 +69,13 @@ class FingerPusher:
     def tilt(self) -> float:
         return 0.0  # slide joints only: the finger always points down
 
+    def state(self) -> tuple:
+        """What the finger keeps outside ``MjData``: nothing (:meth:`Simulator.snapshot`)."""
+        return ()
+
+    def restore(self, state: tuple) -> None:
+        """Undo to :meth:`state` (with ``MjData`` restored by the caller)."""
+
     def _teleport(self, pos: np.ndarray) -> None:
         d = self.data
         d.qpos[self._qpos] = pos
@@ -132,6 +139,17 @@ class ArmPusher:
         mujoco.mj_forward(self.model, d)
         self._target = self.tip()
         self._offset = np.zeros(3)
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What the arm keeps outside ``MjData`` (:meth:`Simulator.snapshot`): the commanded fingertip target
+        (world, metres), the force limit's offset to it (metres) and the IK's joint configuration (radians)."""
+        return self._target.copy(), self._offset.copy(), self.ik.q
+
+    def restore(self, state: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+        """Undo to :meth:`state` (with ``MjData`` restored by the caller)."""
+        target, offset, q_ik = state
+        self._target, self._offset = target.copy(), offset.copy()
+        self.ik.set_q(q_ik)
 
     def go_to(self, pos: np.ndarray, servo: Servo) -> None:
         """Transit: up to the safe height, across, and down to ``pos``."""

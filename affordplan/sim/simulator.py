@@ -97,6 +97,16 @@ class Outcome:
 SETTLE_AFTER_FAULTS = ("sank", "speed")
 
 
+@dataclass(frozen=True)
+class SimState:
+    """Everything the simulator's next primitive depends on, copied (:meth:`Simulator.snapshot`): MuJoCo's state
+    and the pusher's own (the arm's commanded target, its force-limit offset and its IK configuration)."""
+
+    model: mujoco.MjModel  # the simulator's own: a state restores only there
+    data: mujoco.MjData
+    pusher: tuple
+
+
 class _Abort(Exception):
     """Internal: a guard fired; carries its reason."""
 
@@ -194,6 +204,20 @@ class Simulator:
             except _Abort:
                 pass
         return self.object_pose()
+
+    def snapshot(self) -> SimState:
+        """A copy of the current state, to :meth:`restore` later: e.g. to try several primitives from one start."""
+        data = mujoco.MjData(self.model)
+        mujoco.mj_copyData(data, self.model, self.data)
+        return SimState(self.model, data, self._pusher.state())
+
+    def restore(self, state: SimState) -> None:
+        """Return to a :meth:`snapshot` of this simulator: what a primitive executed next does is then what it
+        did from the snapshot (physics is deterministic)."""
+        if not isinstance(state, SimState) or state.model is not self.model:
+            raise InputError("restore takes a SimState from this simulator's snapshot()")
+        mujoco.mj_copyData(self.data, self.model, state.data)
+        self._pusher.restore(state.pusher)
 
     def object_pose(self) -> np.ndarray:
         """The object's 4x4 world pose ``T_world_object``."""
