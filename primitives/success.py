@@ -45,7 +45,7 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
-from primitives.frames import load_frame_search
+from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
 from primitives.networks import HybridActorCritic
 
 WEIGHTS_DIR = Path(__file__).parent / "weights"
@@ -269,8 +269,6 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     judged by that request's criterion (a stand-in request's own, not the seed's), so the model keeps its
     meaning, ``P(success | observation)``, and its calibration.
     """
-    from primitives.frames import reframe
-
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
     rng = np.random.default_rng([seed, 1])  # the options drawn; apart from the environment's own stream
@@ -332,8 +330,6 @@ def collect_parallel(fn, args: tuple, n: int, seed: int, workers: int = 1, progr
 
 def fit_frame_calibration(rating: np.ndarray, success: np.ndarray) -> tuple[float, float]:
     """``(a, b)`` of the Platt scaling ``sigmoid(a logit(p) + b)`` of the chosen frames' ratings ``p``."""
-    from primitives.frames import rating_logit
-
     z = torch.from_numpy(rating_logit(rating).astype(np.float32))
     a, b = _platt(z, torch.from_numpy(np.asarray(success, dtype=np.float32))).tolist()
     return float(a), float(b)
@@ -425,8 +421,6 @@ class FrameViews:
     def of(cls, data: Rollouts, policy: HybridActorCritic, skill: str, search,
            progress: bool = True) -> FrameViews:
         """The views of ``data`` (goal-frame rollouts of ``skill`` acting with ``search``)."""
-        from primitives.frames import reframe_obs
-
         sets = {par: search.frames(skill, {} if par else None) for par in (True, False)}
         m = max(len(f) for f in sets.values())
         n = len(data)
@@ -655,8 +649,6 @@ def _run(args: argparse.Namespace) -> int:
         return _run_frames(args)
     contrast = None  # the options a frame-contrast start is executed in (checks --contrast-stand-ins first)
     if args.command == "train" and args.contrast:
-        from primitives.frames import FrameSearch
-
         contrast = FrameSearch(CONTRAST_TURNS, mirror=True, stand_ins=args.contrast_stand_ins)
     out = Path(args.out or f"runs/{args.skill}_success")
     out.mkdir(parents=True, exist_ok=True)
@@ -722,7 +714,6 @@ def _run(args: argparse.Namespace) -> int:
 def _run_frames(args: argparse.Namespace) -> int:
     """``frames``: frame-searched rollouts on training objects, and the Platt scaling of the chosen ratings."""
     from primitives.evaluate import load_policy
-    from primitives.frames import FrameSearch
 
     asked = FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)  # checks --turns / --stand-ins first
     search = replace(asked, stand_ins=0)  # the first pass calibrates the frames alone
@@ -772,8 +763,6 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
     """``evaluate --frames``: the skill acting with a frame search on unseen objects, judged by two raters on the
     same rollouts: the calibrated rating of the chosen frame, and the searched success model, which rates the
     searched skill from the goal frame alone (the shipped ``{skill}_success_searched.pt``, or ``--searched``)."""
-    from primitives.frames import reframe_obs
-
     search = load_frame_search(args.skill, args.frames)
     rating, data = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
                                         seed=args.seed, progress=not args.json)

@@ -263,3 +263,9 @@ def test_frame_contrast_rollouts_may_act_as_the_stand_in_requests():
     assert np.abs(mirrored - asked.obs[1]).max() < 2e-3  # a direction's options: its two mirror frames
     with pytest.raises(SystemExit):
         success.main(["train", "push", "--contrast-stand-ins", "24"])  # needs --contrast
+
+
+def test_a_bad_stand_in_count_for_contrast_is_refused_before_anything_is_written(tmp_path, capsys):
+    out = tmp_path / "no"
+    assert success.main(["train", "push", "--contrast", "2", "--contrast-stand-ins", "18", "--out", str(out)]) == 2
+    assert "multiple of turns" in capsys.readouterr().err and not out.exists()
