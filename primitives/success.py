@@ -49,16 +49,18 @@ from primitives.frames import FrameSearch, load_frame_search, rating_logit, refr
 from primitives.networks import HybridActorCritic
 
 WEIGHTS_DIR = Path(__file__).parent / "weights"
-N_DECISION = 13  # policy-decision features, see decision_features
+N_DECISION = 14  # policy-decision features, see decision_features (files fitted before 0.20 use the first 13)
 CONTRAST_TURNS = 12  # turns about the vertical of frame-contrast rollouts, as the shipped frame searches try
 
 
 def decision_features(policy: HybridActorCritic, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """The policy's greedy decision on a batch ``(B, N, 9)`` and its summary ``(B, 13)``.
+    """The policy's greedy decision on a batch ``(B, N, 9)`` and its summary ``(B, 14)``.
 
-    Returns ``(index (B,), motion (B, 3), features (B, 13))``; the features are the chosen Q, the
+    Returns ``(index (B,), motion (B, 3), features (B, 14))``; the features are the chosen Q, the
     map's max minus its mean, its std, a softmax-entropy, the contact's observation (position,
-    normal) and the motion.
+    normal), the motion, and the motion line's lever arm: the distance in the table plane from the cloud's
+    centroid (the observation's origin) to the line through the contact along the motion, in cm. A push whose
+    line passes more than a centimetre from the centroid turns the object about it.
     """
     actions, q = policy.maps(obs)
     idx = q.argmax(dim=1)
@@ -67,18 +69,22 @@ def decision_features(policy: HybridActorCritic, obs: torch.Tensor) -> tuple[tor
     probs = torch.softmax(q / 0.1, dim=1)
     entropy = -(probs * torch.log(probs + 1e-12)).sum(dim=1) / np.log(q.shape[1])
     motion = actions[rows, idx]
+    contact = obs[rows, idx, :2]
+    along = motion[:, :2] / motion[:, :2].norm(dim=1, keepdim=True).clamp_min(1e-6)
+    lever = (contact[:, 0] * along[:, 1] - contact[:, 1] * along[:, 0]).abs() * 100.0
     feats = torch.cat([torch.stack([q_max, q_max - q.mean(dim=1), q.std(dim=1), entropy], dim=1),
-                       obs[rows, idx, :6] * torch.tensor([10, 10, 10, 1, 1, 1.0]), motion], dim=1)
+                       obs[rows, idx, :6] * torch.tensor([10, 10, 10, 1, 1, 1.0]), motion, lever[:, None]], dim=1)
     return idx, motion, feats
 
 
 class _Member(nn.Module):
-    """One PointNet of the ensemble: logit from scaled points ``(B, N, 9)`` and decision features ``(B, 13)``."""
+    """One PointNet of the ensemble: logit from scaled points ``(B, N, 9)`` and decision features
+    ``(B, n_decision)``."""
 
-    def __init__(self, in_dim: int, width: int):
+    def __init__(self, in_dim: int, width: int, n_decision: int = N_DECISION):
         super().__init__()
         self.points = nn.Sequential(nn.Linear(in_dim, width), nn.ReLU(), nn.Linear(width, 2 * width), nn.ReLU())
-        self.head = nn.Sequential(nn.Linear(4 * width + N_DECISION, 2 * width), nn.ReLU(),
+        self.head = nn.Sequential(nn.Linear(4 * width + n_decision, 2 * width), nn.ReLU(),
                                   nn.Linear(2 * width, width), nn.ReLU(), nn.Linear(width, 1))
 
     def forward(self, x: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
@@ -87,17 +93,19 @@ class _Member(nn.Module):
 
 
 class SuccessNet(nn.Module):
-    """Logit of success from an observation ``(B, N, 9)`` and decision features ``(B, 13)``.
+    """Logit of success from an observation ``(B, N, 9)`` and decision features ``(B, >= n_decision)``.
 
     The mean logit of ``members`` independently initialised and trained PointNets (a deep ensemble: it ranks
-    outcomes better than any one member), then one Platt scaling of that mean.
+    outcomes better than any one member), then one Platt scaling of that mean. ``n_decision``: how many of
+    :func:`decision_features` it reads, the first ones (13 for files fitted before the lever arm was added).
     """
 
-    def __init__(self, in_dim: int = OBS_DIM, width: int = 64, members: int = 1):
+    def __init__(self, in_dim: int = OBS_DIM, width: int = 64, members: int = 1, n_decision: int = N_DECISION):
         super().__init__()
         if members < 1:
             raise InputError(f"an ensemble needs at least one member, got {members}")
-        self.members = nn.ModuleList(_Member(in_dim, width) for _ in range(members))
+        self.n_decision = n_decision
+        self.members = nn.ModuleList(_Member(in_dim, width, n_decision) for _ in range(members))
         # Platt scaling, fitted after training: p = sigmoid(a * logit + b).
         self.register_buffer("platt", torch.tensor([1.0, 0.0]))
 
@@ -108,6 +116,7 @@ class SuccessNet(nn.Module):
 
     def logit(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
         x = self.scaled(obs)
+        decision = decision[:, :self.n_decision]
         return torch.stack([m(x, decision) for m in self.members]).mean(dim=0)
 
     def forward(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
@@ -120,7 +129,8 @@ class SuccessNet(nn.Module):
         if any(k.startswith(("points.", "head.")) for k in state):
             state = {(k if k == "platt" else f"members.0.{k}"): v for k, v in state.items()}
         members = 1 + max(int(k.split(".")[1]) for k in state if k.startswith("members."))
-        net = cls(members=members)
+        width = state["members.0.points.0.weight"].shape[0]
+        net = cls(width=width, members=members, n_decision=state["members.0.head.0.weight"].shape[1] - 4 * width)
         net.load_state_dict(state)
         return net
 
@@ -451,13 +461,14 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
     calib_groups = rng.choice(groups, size=max(1, int(calib_fraction * len(groups))), replace=False)
     calib_mask = np.isin(data.group, calib_groups)
     train, calib = data.subset(~calib_mask), data.subset(calib_mask)
-    net = SuccessNet(members=members)
+    net = SuccessNet(members=members, n_decision=data.decision.shape[1])
     x = SuccessNet.scaled(torch.from_numpy(train.obs.astype(np.float32)))
     dec = torch.from_numpy(train.decision)
     y = torch.from_numpy(train.success.astype(np.float32))
     if views is not None:
         views = views.subset(~calib_mask)
-        view_frames, view_dec = torch.from_numpy(views.frames), torch.from_numpy(views.decision)
+        view_frames = torch.from_numpy(views.frames)
+        view_dec = torch.from_numpy(views.decision[..., :net.n_decision])  # as many as the rollouts carry
         view_count = torch.from_numpy(views.count)
     bar = tqdm(total=members * epochs, desc="fit success model", disable=not progress, unit="epoch")
     for k, member in enumerate(net.members):

@@ -194,7 +194,9 @@ def test_frame_contrast_rollouts_execute_one_start_in_several_frames():
         assert not np.allclose(obs[i], obs[0], atol=1e-2)  # frames drawn without replacement
         assert min(np.abs(t - obs[i]).max() for t in turned) < 2e-3  # fp16-stored clouds
     _, _, decision = success.decision_features(policy, torch.from_numpy(obs))
-    assert torch.allclose(decision, torch.from_numpy(data.decision), atol=0.05)
+    stored = torch.from_numpy(data.decision)
+    assert torch.allclose(decision[:, :13], stored[:, :13], atol=0.05)
+    assert torch.allclose(decision[:, 13], stored[:, 13], atol=0.2)  # the lever arm is in cm, the others ~dm
     again = success.collect_contrast(policy, "spin", 6, search, 3, "train", n_objects=3, seed=1, p_params=1.0,
                                      progress=False)
     assert np.array_equal(again.obs, data.obs) and np.array_equal(again.success, data.success)
@@ -269,3 +271,42 @@ def test_a_bad_stand_in_count_for_contrast_is_refused_before_anything_is_written
     out = tmp_path / "no"
     assert success.main(["train", "push", "--contrast", "2", "--contrast-stand-ins", "18", "--out", str(out)]) == 2
     assert "multiple of turns" in capsys.readouterr().err and not out.exists()
+
+
+class _FixedPolicy:
+    """Stands in for a policy whose greedy decision is point ``index`` with ``motion``."""
+
+    def __init__(self, index: int, motion):
+        self.index, self.motion = index, torch.tensor(motion, dtype=torch.float32)
+
+    def maps(self, obs):
+        q = torch.zeros(obs.shape[:2])
+        q[:, self.index] = 1.0
+        return self.motion.expand(*obs.shape[:2], 3).clone(), q
+
+
+def test_the_lever_arm_feature_is_the_motion_lines_distance_from_the_centroid():
+    """The last decision feature: a push along +x through a contact 2 cm to the side of the cloud's centroid (the
+    observation's origin) has a 2 cm lever arm; along +y through the same contact, 5 cm."""
+    obs = torch.zeros(1, 8, 9)
+    obs[0, 3, :3] = torch.tensor([-0.05, 0.02, 0.03])  # 5 cm behind the centroid, 2 cm to its left, 3 cm up
+    _, _, along_x = success.decision_features(_FixedPolicy(3, [1.0, 0.0, -0.2]), obs)
+    _, _, along_y = success.decision_features(_FixedPolicy(3, [0.0, 0.7, 0.0]), obs)
+    assert along_x.shape == (1, success.N_DECISION)
+    assert along_x[0, -1].item() == pytest.approx(2.0, abs=1e-4)  # cm
+    assert along_y[0, -1].item() == pytest.approx(5.0, abs=1e-4)
+    _, _, still = success.decision_features(_FixedPolicy(3, [0.0, 0.0, -1.0]), obs)  # straight down: no line
+    assert torch.isfinite(still).all()
+
+
+def test_a_model_fitted_before_the_lever_arm_reads_only_its_thirteen_features():
+    from primitives.skills import load_skill
+
+    net = load_skill("push").success_model.net
+    assert net.n_decision == 13
+    obs = torch.randn(3, 256, 9) * 0.03
+    dec = torch.randn(3, success.N_DECISION)
+    other = dec.clone()
+    other[:, 13:] = 1e3
+    with torch.no_grad():
+        assert torch.equal(net(obs, dec), net(obs, other))
