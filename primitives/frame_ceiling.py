@@ -38,9 +38,9 @@ from tqdm import tqdm
 from affordplan.errors import AffordplanError
 from primitives.env import PRIMITIVES, PrimitiveEnv
 from primitives.evaluate import greedy_action, held_out_config, load_policy
-from primitives.frames import FrameSearch, load_frame_search, reframe_obs
+from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
-from primitives.success import auroc
+from primitives.success import SuccessModel, auroc, load_success_net
 
 
 @dataclass(frozen=True)
@@ -133,8 +133,7 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     skill, sim, seen = env.config.primitive, env.sim, env.seen
     start = sim.snapshot()
     options = search.options(skill, seen, sim)
-    raw = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
-    ratings = np.split(raw, np.cumsum([len(f) for _, f in options])[:-1])
+    ratings = search.rate(options, predict)
     k_pick, j_pick, _ = search.choose(options, ratings)
     option, frame, q_max, success = [], [], [], []
     for k, (_, frames) in enumerate(options):
@@ -148,8 +147,9 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     env.seen = seen
     option, frame = np.array(option), np.array(frame)
     parameterised = np.array([options[k][0].params is not None for k in option])
-    return StartOptions(seen.params, option, frame, search.calibrate_kind(raw, parameterised), np.array(q_max),
-                        np.array(success, dtype=bool), int(np.flatnonzero((option == k_pick) & (frame == j_pick))[0]))
+    pick = int(np.flatnonzero((option == k_pick) & (frame == j_pick))[0])
+    return StartOptions(seen.params, option, frame, search.calibrate_kind(np.concatenate(ratings), parameterised),
+                        np.array(q_max), np.array(success, dtype=bool), pick)
 
 
 def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: int = 1234,
@@ -157,8 +157,6 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
     """Every option of ``starts`` held-out starts of ``skill`` (``params``: ``"random"`` asks for a random
     parameter, ``"none"`` the seed's objective), with the policy ``weights``, the success model ``model`` and the
     frame search ``frames`` (``"shipped"`` or a frames.json path; defaults: the shipped ones)."""
-    from primitives.success import SuccessModel, load_success_net
-
     policy = load_policy(weights, skill)
     predict = SuccessModel(policy, load_success_net(skill, model)).predict
     search = load_frame_search(skill, frames)

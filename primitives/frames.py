@@ -179,6 +179,13 @@ class FrameSearch:
                 options.append((asked, self.frames(skill, request)))
         return options
 
+    @staticmethod
+    def rate(options: list[tuple[SkillObservation, np.ndarray]], predict) -> list[np.ndarray]:
+        """Each option's ratings, one per frame, from one batch of ``predict`` (observations ``(m, N, 9)`` ->
+        P(success) ``(m,)``)."""
+        p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
+        return np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
+
     def choose(self, options: list[tuple[SkillObservation, np.ndarray]],
                ratings: list[np.ndarray]) -> tuple[int, int, float]:
         """The option and frame to act in, ``(k, j)``, given each option's ratings (one per frame), and its score:
@@ -205,7 +212,7 @@ class FrameSearch:
         """The observation to act on and its score: ``seen`` (of ``sim``'s current cloud) in the free frame, or
         for the seed's objective with stand-ins the free frame of the stand-in request, that ``predict``
         (observations ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch
-        (:meth:`options`, :meth:`choose`).
+        (:meth:`options`, :meth:`rate`, :meth:`choose`).
 
         The returned observation keeps ``seen.params`` (what the outcome is judged by); ``acted_as`` names the
         stand-in request where one was chosen. The score is the best raw rating, or with stand-ins the best rating
@@ -214,8 +221,7 @@ class FrameSearch:
         if not self.tries_stand_ins(seen.params):
             return select_frame(seen, predict, self.frames(skill, seen.params))
         options = self.options(skill, seen, sim)
-        p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])))
-        k, j, score = self.choose(options, np.split(p, np.cumsum([len(f) for _, f in options])[:-1]))
+        k, j, score = self.choose(options, self.rate(options, predict))
         return self.acting(options, k, j), score
 
     def calibrate_kind(self, p: np.ndarray | float, parameterised: np.ndarray | bool) -> np.ndarray:
