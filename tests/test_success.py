@@ -302,7 +302,7 @@ def test_the_lever_arm_feature_is_the_motion_lines_distance_from_the_centroid():
 def test_a_model_fitted_before_the_lever_arm_reads_only_its_thirteen_features():
     from primitives.skills import load_skill
 
-    net = load_skill("push").success_model.net
+    net = load_skill("roll").success_model.net  # roll's shipped files predate the lever arm
     assert net.n_decision == 13
     obs = torch.randn(3, 256, 9) * 0.03
     dec = torch.randn(3, success.N_DECISION)
@@ -310,3 +310,16 @@ def test_a_model_fitted_before_the_lever_arm_reads_only_its_thirteen_features():
     other[:, 13:] = 1e3
     with torch.no_grad():
         assert torch.equal(net(obs, dec), net(obs, other))
+
+
+def test_the_shipped_push_model_reads_the_lever_arm():
+    from primitives.skills import load_skill
+
+    net = load_skill("push").success_model.net  # 0.20's push files were fitted with the lever arm
+    assert net.n_decision == success.N_DECISION == 14
+    obs = torch.randn(3, 256, 9) * 0.03
+    dec = torch.randn(3, success.N_DECISION)
+    other = dec.clone()
+    other[:, 13] += 5.0  # the line 5 cm further from the centroid
+    with torch.no_grad():
+        assert not torch.allclose(net(obs, dec), net(obs, other))
