@@ -62,7 +62,7 @@ def _run_kwargs(args: argparse.Namespace) -> dict:
     return dict(sim=args.sim, planner=args.planner, max_primitives=args.max_primitives, seed=args.seed,
                 time_limit=args.time_limit, video=not args.no_video, width=args.width, height=args.height,
                 fps=args.fps, frame_interval=args.frame_interval, camera=args.camera, viewer=args.viewer,
-                progress=not args.quiet)
+                progress=not args.quiet, weights_dir=args.weights_dir)
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
@@ -176,6 +176,9 @@ def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_pr
     p.add_argument("--time-limit", type=float, default=5.0, metavar="S",
                    help="seconds per planning call (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="seeds the planner and the point clouds (default: %(default)s)")
+    p.add_argument("--weights-dir", default=None, metavar="DIR",
+                   help="run the skills from this folder's files (laid out like primitives/weights/, e.g. a "
+                        "candidate set under primitives/weights/candidates/) instead of the shipped ones")
     video = p.add_argument_group("video")
     video.add_argument("--no-video", "--no-render", dest="no_video", action="store_true",
                        help="skip rendering: only plan.png and summary.json are written")

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from affordplan import versions
 from affordplan.checks import require_whole
 from affordplan.errors import InputError
 from affordplan.geometry import transform_points
@@ -127,6 +128,7 @@ class SceneRun:
     files: dict[str, Path] = field(default_factory=dict)
     wall_time: float = 0.0
     off_table: list[tuple[int, float]] = field(default_factory=list)
+    weights_dir: str | None = None
 
     @property
     def success(self) -> bool:
@@ -138,7 +140,8 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
               max_primitives: int = DEMO_MAX_PRIMITIVES, seed: int = 0, time_limit: float = 5.0,
               video: bool = True, width: int = 480, height: int = 360, fps: float = 10.0,
               frame_interval: float = 0.25, camera: str | None = None, viewer: bool = False,
-              progress: bool = True, echo: Callable[[str], None] = print) -> SceneRun:
+              progress: bool = True, echo: Callable[[str], None] = print,
+              weights_dir: str | Path | None = None) -> SceneRun:
     """Plan and execute ``scene``, print the plan and the outcome, write the outputs to ``out_dir``.
 
     Args:
@@ -158,9 +161,13 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
         viewer: also show MuJoCo's interactive viewer when a display exists.
         progress: show a progress bar (primitives executed, frames rendered) on stderr.
         echo: where the report lines go.
+        weights_dir: run the skills from this folder's files instead of the shipped ones, e.g. a candidate set
+            under ``primitives/weights/candidates/`` (:func:`primitives.skills.load_skills`; a skill without
+            files there stays shipped).
 
     Raises:
-        AffordplanError: bad scene or options, or no first plan (PlanningError / GoalError).
+        AffordplanError: bad scene or options (an unusable ``weights_dir`` included, before anything is planned),
+            or no first plan (PlanningError / GoalError).
     """
     import affordplan as ap
 
@@ -180,9 +187,16 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
          f"{len(scene.obstacles)} obstacles")
 
     t_plan = time.perf_counter()
+    predictor = None
+    if weights_dir is not None:
+        from planner.predict import Predictor
+        from primitives.skills import load_skills
+
+        echo(f"skills: the files in {weights_dir} where it has them, else the shipped ones")
+        predictor = Predictor(obj, skills=load_skills(weights_dir), seed=seed)  # the seed plan() would give it
     echo(f"planning ({planner}; loading the skills and success models first) ...")
     plan = ap.plan(obj, scene.goal, start=scene.start, obstacles=scene.obstacles, time_limit=time_limit,
-                   planner=planner, seed=seed)
+                   planner=planner, seed=seed, predictor=predictor)
     echo(str(plan))
 
     t_exec = time.perf_counter()
@@ -210,7 +224,7 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
 
     xy_error, yaw_error, state_ok = scene.goal.errors(obj, execution.final_pose)
     run = SceneRun(scene, plan, execution, xy_error, yaw_error, state_ok, obj.classify(execution.final_pose),
-                   off_table=watch.off_table)
+                   off_table=watch.off_table, weights_dir=None if weights_dir is None else str(weights_dir))
     for line in outcome_lines(run, obj):
         echo(line)
     _write_outputs(run, obj, out, recorder, watch.keyframes, fps, t_start)
@@ -315,6 +329,8 @@ def summary(run: SceneRun, obj: ObjectModel) -> dict:
         "off_table": [{"after_primitive": k, "lowest_point_m": h} for k, h in run.off_table],
         "files": {k: p.name for k, p in run.files.items()},
         "wall_time_s": run.wall_time,
+        "weights": run.weights_dir or "shipped",
+        "versions": versions(),
     }
 
 

@@ -2,25 +2,35 @@
 
     python examples/demo_start_yaws.py                 # the nine yaws the README quotes
     python examples/demo_start_yaws.py -150 0 90       # yaws of your own, degrees
+    python examples/demo_start_yaws.py --weights-dir primitives/weights/candidates/push_0.18   # other skill files
 """
 
+import argparse
 import math
-import sys
 
 import affordplan as ap
 from affordplan.scene_file import demo_scene
+from planner.predict import Predictor
+from primitives.skills import load_skills
 
 YAWS_DEG = (29.0, -150.0, -105.0, -60.0, -15.0, 30.0, 75.0, 120.0, 165.0)
 
 if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("yaws", nargs="*", type=float, metavar="DEG",
+                        help="start yaws, degrees (default: the nine the README quotes)")
+    parser.add_argument("--weights-dir", default=None, metavar="DIR",
+                        help="run the skills from this folder's files instead of the shipped ones")
+    args = parser.parse_args()
     scene = demo_scene()
     obj = ap.load_object(scene.object)
-    yaws = [float(a) for a in sys.argv[1:]] or YAWS_DEG
+    yaws = args.yaws or YAWS_DEG
     reached = 0
     for yaw_deg in yaws:
         start = dict(scene.start, yaw=math.radians(yaw_deg))
         try:
-            plan = ap.plan(obj, scene.goal, start=start, obstacles=scene.obstacles)
+            plan = ap.plan(obj, scene.goal, start=start, obstacles=scene.obstacles,
+                           predictor=Predictor(obj, skills=load_skills(args.weights_dir), seed=0))  # as plan() would
             ex = plan.execute(sim="arm", max_primitives=30)
             ok, detail = ex.success, f"{ex.n_primitives} primitives: {ex.reason}"
         except ap.errors.AffordplanError as exc:

@@ -31,8 +31,8 @@ from affordplan.objects.model import ObjectModel, random_object
 from affordplan.world import Box, Workspace
 from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, inflated_footprints, make_checkers
-from planner.predict import SKILLS, Predictor
-from primitives.skills import load_skill
+from planner.predict import Predictor
+from primitives.skills import load_skills
 
 # seed S's tasks take test objects 1000 S, 1000 S + 1, ... (until release 0.7: objects 0-49 for every seed)
 OBJECTS_PER_SEED = 1000
@@ -215,7 +215,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     outcome moves by chance alone, the yardstick for a change that alters plans.
 
     ``weights_dir``: run the skills from this folder's files instead of the shipped ones
-    (:func:`primitives.skills.load_skill`; a skill without files there stays shipped), e.g. to bench a
+    (:func:`primitives.skills.load_skills`; a skill without files there stays shipped), e.g. to bench a
     candidate set of weights before shipping it.
 
     ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
@@ -230,7 +230,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     wanted = range(n_tasks) if only is None else sorted(set(only))
     if not wanted or not all(0 <= i < OBJECTS_PER_SEED for i in wanted):
         raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
-    skills = None if weights_dir is None else {name: load_skill(name, weights_dir=weights_dir) for name in SKILLS}
+    skills = None if weights_dir is None else load_skills(weights_dir)
     rng = np.random.default_rng(seed)
     report = BenchReport(draw=draw)
     bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")

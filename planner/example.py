@@ -8,19 +8,30 @@ from pathlib import Path
 
 import affordplan as ap
 from planner.plot import plot_plan, save_frames
+from planner.predict import Predictor
+from primitives.skills import load_skills
 
 
 def run_example(name: str, obj, goal, start, obstacles, description: str) -> int:
+    """Parse the example's command line (``--sim``, ``--out``, ``--seed``, ``--max-primitives``, ``--no-render``,
+    ``--weights-dir``), plan, execute, print the outcome and write ``plan.png`` and ``frames.png``; returns the exit
+    status (0: goal reached)."""
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--sim", default="arm", choices=["arm", "finger"])
     parser.add_argument("--out", default=f"affordplan-examples/{name}")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--max-primitives", type=int, default=60)
     parser.add_argument("--no-render", action="store_true")
+    parser.add_argument("--weights-dir", default=None, metavar="DIR",
+                        help="run the skills from this folder's files (laid out like primitives/weights/, e.g. a "
+                             "candidate set) instead of the shipped ones")
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    plan = ap.plan(obj, goal, start=start, obstacles=obstacles, seed=args.seed)
+    predictor = None
+    if args.weights_dir is not None:
+        predictor = Predictor(obj, skills=load_skills(args.weights_dir), seed=args.seed)  # plan()'s seed
+    plan = ap.plan(obj, goal, start=start, obstacles=obstacles, seed=args.seed, predictor=predictor)
     print(plan)
     ex = plan.execute(sim=args.sim, max_primitives=args.max_primitives, seed=args.seed,
                       render=None if args.no_render else "overview")

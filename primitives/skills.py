@@ -211,3 +211,13 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
     searched_weights = searched_path if searched and shipped and searched_path.exists() else None
     return Skill(name, load_policy(weights, name), success_weights=success_weights, frame_search=frame_search,
                  searched_weights=searched_weights)
+
+
+def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[str, Skill]:
+    """All three skills, ``{"push": Skill, "roll": ..., "spin": ...}``: the shipped ones, or with ``weights_dir`` each
+    skill whose ``{name}.pt`` is in that folder from the folder's files (:func:`load_skill`), the others shipped.
+
+    Raises:
+        InputError: ``weights_dir`` is not a folder, or a policy in it has no success model beside it.
+    """
+    return {name: load_skill(name, weights_dir=weights_dir) for name in PRIMITIVES}

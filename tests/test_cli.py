@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+import affordplan as ap
 from affordplan import cli
 from affordplan.bench import bench_sim
 from affordplan.errors import InputError, MeshError
@@ -265,6 +266,7 @@ def test_demo_one_primitive_in_the_arm_sim_writes_every_output(tmp_path, capsys,
     assert summary["execution"]["n_primitives"] == 1 and summary["plan"]["route"] == [0, 1]
     assert summary["files"] == {"plan": "plan.png", "frames": "frames.png", "video": "video.mp4",
                                 "summary": "summary.json"}
+    assert summary["weights"] == "shipped" and summary["versions"]["affordplan"] == ap.__version__
     assert Image.open(out / "plan.png").size[0] > 300 and Image.open(out / "frames.png").size[0] > 96
     import imageio.v2 as imageio
 
@@ -281,9 +283,30 @@ def test_a_finished_run_exits_0_and_check_makes_a_missed_goal_exit_1(monkeypatch
 
     monkeypatch.setattr("affordplan.demo.run_demo", fake_run_demo)
     assert cli.main(["demo"]) == 0
-    assert cli.main(["demo", "--check", "--sim", "finger", "--no-video"]) == 1
+    assert cli.main(["demo", "--check", "--sim", "finger", "--no-video", "--weights-dir", "cand"]) == 1
     assert seen[0]["sim"] == "arm" and seen[0]["max_primitives"] == 30 and seen[0]["video"]
-    assert seen[1]["sim"] == "finger" and not seen[1]["video"]
+    assert seen[0]["weights_dir"] is None
+    assert seen[1]["sim"] == "finger" and not seen[1]["video"] and seen[1]["weights_dir"] == "cand"
+
+
+def test_a_scene_runs_the_skills_of_a_weights_folder(tmp_path):
+    from affordplan.demo import run_scene
+    from primitives.success import WEIGHTS_DIR
+
+    kept = WEIGHTS_DIR / "candidates" / "push_0.18"
+    lines: list[str] = []
+    run = run_scene(demo_scene(), tmp_path, sim="finger", max_primitives=1, video=False, progress=False,
+                    echo=lines.append, weights_dir=kept)
+    skills = run.plan.planner.predictor.skills
+    assert skills["push"].success_model.net.n_decision == 13  # the folder's push, fitted before the lever arm
+    assert skills["roll"]._searched_weights == WEIGHTS_DIR / "roll_success_searched.pt"  # none there: shipped
+    assert run.execution.n_primitives == 1
+    assert any(str(kept) in line for line in lines)
+    assert json.loads((tmp_path / "summary.json").read_text())["weights"] == str(kept)
+    with pytest.raises(InputError, match="not a folder"):  # refused before anything is planned
+        run_scene(demo_scene(), tmp_path / "other", sim="finger", video=False, progress=False,
+                  echo=lines.append, weights_dir=tmp_path / "missing")
+    assert not (tmp_path / "other" / "summary.json").exists()
 
 
 # ----------------------------------------------------------------------------------- bench

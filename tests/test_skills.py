@@ -126,6 +126,19 @@ def test_a_weights_folder_without_a_skill_leaves_it_shipped(tmp_path):
     assert spin.frame_search == load_skill("spin").frame_search
 
 
+def test_load_skills_takes_a_folder_skill_by_skill():
+    kept = skills_module.WEIGHTS_DIR / "candidates" / "push_0.18"  # push files only, fitted before the lever arm
+    shipped, mixed = skills_module.load_skills(), skills_module.load_skills(kept)
+    assert set(shipped) == set(mixed) == {"push", "roll", "spin"}
+    assert shipped["push"].success_model.net.n_decision == 14 and mixed["push"].success_model.net.n_decision == 13
+    assert mixed["push"]._searched_weights == kept / "push_success_searched.pt"
+    for name in ("roll", "spin"):  # no files of theirs in the folder: shipped
+        assert mixed[name]._searched_weights == shipped[name]._searched_weights
+        assert mixed[name].frame_search == shipped[name].frame_search
+    with pytest.raises(InputError, match="not a folder"):
+        skills_module.load_skills(kept / "missing")
+
+
 def test_a_weights_folder_is_refused_without_a_success_model_or_beside_other_files(tmp_path):
     _copy_skill_files("push", tmp_path, files=("{}.pt",))
     with pytest.raises(InputError, match="no success model beside it"):
