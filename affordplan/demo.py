@@ -190,10 +190,9 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
     predictor = None
     if weights_dir is not None:
         from planner.predict import Predictor
-        from primitives.skills import load_skills
 
         echo(f"skills: the files in {weights_dir} where it has them, else the shipped ones")
-        predictor = Predictor(obj, skills=load_skills(weights_dir), seed=seed)  # the seed plan() would give it
+        predictor = Predictor(obj, seed=seed, weights_dir=weights_dir)  # the seed plan() would give its own
     echo(f"planning ({planner}; loading the skills and success models first) ...")
     plan = ap.plan(obj, scene.goal, start=scene.start, obstacles=scene.obstacles, time_limit=time_limit,
                    planner=planner, seed=seed, predictor=predictor)

@@ -11,7 +11,6 @@ import math
 import affordplan as ap
 from affordplan.scene_file import demo_scene
 from planner.predict import Predictor
-from primitives.skills import load_skills
 
 YAWS_DEG = (29.0, -150.0, -105.0, -60.0, -15.0, 30.0, 75.0, 120.0, 165.0)
 
@@ -30,7 +29,7 @@ if __name__ == "__main__":
         start = dict(scene.start, yaw=math.radians(yaw_deg))
         try:
             plan = ap.plan(obj, scene.goal, start=start, obstacles=scene.obstacles,
-                           predictor=Predictor(obj, skills=load_skills(args.weights_dir), seed=0))  # as plan() would
+                           predictor=Predictor(obj, seed=0, weights_dir=args.weights_dir))  # as plan() would
             ex = plan.execute(sim="arm", max_primitives=30)
             ok, detail = ex.success, f"{ex.n_primitives} primitives: {ex.reason}"
         except ap.errors.AffordplanError as exc:

@@ -9,7 +9,6 @@ from pathlib import Path
 import affordplan as ap
 from planner.plot import plot_plan, save_frames
 from planner.predict import Predictor
-from primitives.skills import load_skills
 
 
 def run_example(name: str, obj, goal, start, obstacles, description: str) -> int:
@@ -28,9 +27,7 @@ def run_example(name: str, obj, goal, start, obstacles, description: str) -> int
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    predictor = None
-    if args.weights_dir is not None:
-        predictor = Predictor(obj, skills=load_skills(args.weights_dir), seed=args.seed)  # plan()'s seed
+    predictor = Predictor(obj, seed=args.seed, weights_dir=args.weights_dir)  # as plan() makes one, but for the folder
     plan = ap.plan(obj, goal, start=start, obstacles=obstacles, seed=args.seed, predictor=predictor)
     print(plan)
     ex = plan.execute(sim=args.sim, max_primitives=args.max_primitives, seed=args.seed,

@@ -10,14 +10,17 @@ state at the same place on the table.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
+from affordplan.errors import InputError
 from affordplan.geometry import transform_points
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import TABLE_CONTACT_HEIGHT
 from primitives import params as skill_params
 from primitives.env import observe_cloud
-from primitives.skills import Skill, load_skill
+from primitives.skills import Skill, load_skills
 
 N_POINTS = 256
 SKILLS = ("push", "spin", "roll")
@@ -47,13 +50,21 @@ class Predictor:
 
     Args:
         obj: the object.
-        skills: ``{"push": Skill, ...}``; the shipped skills by default.
+        skills: ``{"push": Skill, ...}``; by default the shipped skills, or with ``weights_dir`` the skills of that
+            folder (:func:`primitives.skills.load_skills`: a candidate set; a skill without files there shipped).
         seed: seeds the choice of cloud points (queries are deterministic for a given seed).
+        weights_dir: see ``skills``; not combined with it.
+
+    Raises:
+        InputError: both ``skills`` and ``weights_dir``, or an unusable ``weights_dir``.
     """
 
-    def __init__(self, obj: ObjectModel, skills: dict[str, Skill] | None = None, seed: int = 0):
+    def __init__(self, obj: ObjectModel, skills: dict[str, Skill] | None = None, seed: int = 0,
+                 weights_dir: str | os.PathLike | None = None):
+        if skills is not None and weights_dir is not None:
+            raise InputError("give skills or weights_dir, not both")
         self.obj = obj
-        self.skills = skills or {name: load_skill(name) for name in SKILLS}
+        self.skills = skills or load_skills(weights_dir)
         self._samples, self._normals = obj.surface_samples()
         self._seed = seed
         self.queries = 0

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import affordplan as ap
-from affordplan.errors import GoalError, PlanningError
+from affordplan.errors import GoalError, InputError, PlanningError
 from affordplan.geometry import wrap_angle
 from affordplan.objects.model import random_object
 from affordplan.sim.simulator import Outcome
@@ -553,7 +553,6 @@ def test_bench_tasks_can_be_solved_in_principle():
 
 
 def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
-    from affordplan.errors import InputError
     from planner.bench import OBJECTS_PER_SEED, bench_plan, make_task
 
     _, obj = make_task(np.random.default_rng(3), OBJECTS_PER_SEED * 3 + 7)
@@ -667,3 +666,15 @@ def test_a_goal_free_only_in_a_narrow_band_of_yaws_is_accepted_and_reached():
     assert checker.is_free(x, y, yaw)  # the path ends at the goal, at one of the few yaws that fit
     ex = execute_plan(plan, sim=ap.Simulator(obj, obstacles=blocks, pusher="finger", seed=0), max_primitives=30)
     assert ex.success
+
+
+def test_a_predictor_loads_a_weights_folder_or_takes_skills_not_both(cube):
+    from planner.predict import Predictor
+    from primitives.success import WEIGHTS_DIR
+
+    kept = WEIGHTS_DIR / "candidates" / "push_0.18"  # push only, fitted before the lever arm
+    predictor = Predictor(cube, weights_dir=kept)
+    assert predictor.skills["push"].success_model.net.n_decision == 13
+    assert Predictor(cube).skills["push"].success_model.net.n_decision == 14
+    with pytest.raises(InputError, match="not both"):
+        Predictor(cube, skills=predictor.skills, weights_dir=kept)
