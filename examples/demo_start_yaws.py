@@ -24,12 +24,13 @@ if __name__ == "__main__":
     scene = demo_scene()
     obj = ap.load_object(scene.object)
     yaws = args.yaws or YAWS_DEG
+    predictor = Predictor(obj, seed=0, weights_dir=args.weights_dir)  # as plan() makes one; loaded once for all yaws
     reached = 0
     for yaw_deg in yaws:
         start = dict(scene.start, yaw=math.radians(yaw_deg))
         try:
             plan = ap.plan(obj, scene.goal, start=start, obstacles=scene.obstacles,
-                           predictor=Predictor(obj, seed=0, weights_dir=args.weights_dir))  # as plan() would
+                           predictor=predictor)
             ex = plan.execute(sim="arm", max_primitives=30)
             ok, detail = ex.success, f"{ex.n_primitives} primitives: {ex.reason}"
         except ap.errors.AffordplanError as exc:
