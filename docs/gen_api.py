@@ -35,7 +35,7 @@ MODULES: list[tuple[str, list[str]]] = [
                               "affordplan.sim.pushers", "affordplan.geometry"]),
     ("Learning", ["primitives.env", "primitives.networks", "primitives.replay", "primitives.train",
                   "primitives.evaluate", "primitives.ceiling", "primitives.frame_ceiling", "primitives.scripted",
-                  "primitives.success", "primitives.affordances", "primitives.ship",
+                  "primitives.success", "primitives.ensemble", "primitives.affordances", "primitives.ship",
                   "primitives.curves", "primitives.checkpoint"]),
     ("Planning internals", ["planner.graph", "planner.footprint", "planner.motion", "planner.chain",
                             "planner.predict"]),

@@ -44,6 +44,7 @@ from torch import nn
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
+from primitives.ensemble import StackedEnsemble
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
 from primitives.networks import HybridActorCritic
@@ -136,11 +137,16 @@ class SuccessNet(nn.Module):
 
 
 class SuccessModel:
-    """A skill's policy and its success model, answering queries on observations."""
+    """A skill's policy and its success model, answering queries on observations.
+
+    Queries go through a :class:`~primitives.ensemble.StackedEnsemble` of ``net``, built here: a snapshot of the
+    net's weights, so build the model after training the net, not before.
+    """
 
     def __init__(self, policy: HybridActorCritic, net: SuccessNet):
         self.policy = policy.eval()
         self.net = net.eval()
+        self._stacked = StackedEnsemble(self.net)
 
     @torch.no_grad()
     def predict(self, obs: np.ndarray) -> np.ndarray:
@@ -149,7 +155,7 @@ class SuccessModel:
         single = x.ndim == 2
         x = x[None] if single else x
         _, _, d = decision_features(self.policy, x)
-        p = self.net(x, d).numpy()
+        p = self._stacked(x, d).numpy()
         return p[0] if single else p
 
 
