@@ -169,12 +169,10 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
     return out
 
 
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="python -m primitives.frame_ceiling", description=__doc__.split("\n\n")[0],
-        epilog="examples:\n  python -m primitives.frame_ceiling spin --starts 100 --params random\n"
-               "  python -m primitives.frame_ceiling push --starts 100 --params none --json",
-        formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_held_out_arguments(p: argparse.ArgumentParser) -> None:
+    """The arguments of a benchmark that acts on the evaluation's held-out starts with a frame search (this one
+    and :mod:`primitives.sensitivity`): the skill, ``--starts``, ``--params``, ``--seed``, the files, ``--plot``
+    and ``--json``."""
     p.add_argument("skill", choices=PRIMITIVES)
     p.add_argument("--starts", type=int, default=100, help="held-out starts (default: 100)")
     p.add_argument("--params", choices=["none", "random"], default="random",
@@ -185,6 +183,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", default="shipped", metavar="shipped|PATH", help="frame search (default: shipped)")
     p.add_argument("--plot", default=None, help="bar chart PNG")
     p.add_argument("--json", action="store_true")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m primitives.frame_ceiling", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n  python -m primitives.frame_ceiling spin --starts 100 --params random\n"
+               "  python -m primitives.frame_ceiling push --starts 100 --params none --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_held_out_arguments(p)
     return p
 
 
