@@ -6,7 +6,7 @@ every layer once per member: 25 small matrix products for five members, each pay
 cloud of a few hundred points. :class:`StackedEnsemble` holds the same weights stacked:
 
 - the members' first point layers side by side, one ``(9, M * width)`` product for all members (they read the
-  same scaled points);
+  same scaled points, or with the contact encoder the same contact-frame points, ``(13, M * width)``);
 - the other layers as ``(M, in, out)`` stacks, one batched product (``baddbmm``) per layer for all members.
 
 It computes what :meth:`SuccessNet.forward` computes (the same sums, grouped differently: the answers agree to
@@ -34,6 +34,7 @@ class StackedEnsemble:
         self.n_members = len(members)
         self.width = first.weight.shape[0]
         self.n_decision = net.n_decision
+        self.contact = net.encoder == "contact"  # the members read contact_frame_input, not the scaled cloud
         with torch.no_grad():
             # First point layer, all members at once: x (B*N, 9) @ (9, M*width).
             self.w_in = torch.cat([m.points[0].weight for m in members]).t().contiguous()
@@ -43,7 +44,7 @@ class StackedEnsemble:
                             torch.stack([layer(m).bias for m in members])[:, None, :].clone())
                            for layer in (lambda m: m.points[2], lambda m: m.head[0], lambda m: m.head[2],
                                          lambda m: m.head[4])]
-            self.scale = net.scaled(torch.ones(1, 1, self.w_in.shape[0])).reshape(-1).clone()
+            self.scale = net.scaled(torch.ones(1, 1, 9)).reshape(-1).clone()
             self.platt = net.platt.clone()
 
     @torch.no_grad()
@@ -54,9 +55,11 @@ class StackedEnsemble:
                 or decision.shape[1] < self.n_decision:
             raise InputError(f"expected observations (B, N, 9) and decision features (B, >= {self.n_decision}), "
                              f"got {tuple(obs.shape)} and {tuple(decision.shape)}")
+        from primitives.success import contact_frame_input  # (success imports this module)
+
         b, n, _ = obs.shape
         m, w = self.n_members, self.width
-        x = (obs * self.scale).reshape(b * n, -1)
+        x = (contact_frame_input(obs, decision) if self.contact else obs * self.scale).reshape(b * n, -1)
         h = torch.addmm(self.b_in, x, self.w_in).relu_().view(b * n, m, w).transpose(0, 1)  # (M, B*N, w)
         (w_pts, b_pts), *head = self.layers
         h = torch.baddbmm(b_pts, h, w_pts).relu_().view(m, b, n, -1)  # (M, B, N, 2w)

@@ -12,6 +12,11 @@ planner, which asks it often. Choices and why:
   the spread of the critic map, the contact's position and normal and the chosen motion. These are
   functions of the cloud and the parameter (the policy is deterministic at evaluation), and they
   carry the critic's estimate of the outcome, which the model only has to calibrate and correct.
+- **Encoder.** ``--encoder cloud`` (the default, every shipped file): the members' point MLP reads the
+  observation. ``--encoder contact``: it reads the cloud as the policy's fingertip meets it, relative to the
+  chosen contact with x along the motion (:func:`contact_frame_input`), so that pooling over points can weigh
+  the geometry ahead of and beside the push; whether one start succeeds in one frame and fails in another
+  hangs on that geometry (``python -m primitives.sensitivity``).
 - **Ensemble.** ``--members K`` trains K such PointNets from different initialisations and batch
   orders on the same data and averages their logits before calibration: a deep ensemble ranks
   outcomes better than its members (their errors differ), at K times the query cost of the nets,
@@ -78,6 +83,31 @@ def decision_features(policy: HybridActorCritic, obs: torch.Tensor) -> tuple[tor
     return idx, motion, feats
 
 
+ENCODERS = ("cloud", "contact")  # what a success net's members read, see SuccessNet
+_CLOUD_DIM, _CONTACT_DIM = OBS_DIM, 13
+
+
+def contact_frame_input(obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+    """The cloud as the policy's fingertip meets it: per point ``(B, N, 13)`` from observations ``(B, N, 9)`` and
+    decision features ``(B, >= 13)`` (:func:`decision_features`: the contact at columns 4-6 in dm, the motion at
+    10-12).
+
+    In the *contact frame* (origin at the contact, x along the motion's horizontal direction, z up): the point's
+    position (dm), its normal, its goal flow (in 5 cm), and its distance to the contact (dm); then its position in
+    the goal frame (dm), as the cloud encoder reads it. A motion with no horizontal part leaves the goal frame's
+    axes.
+    """
+    contact = decision[:, 4:7] / 10.0
+    along = decision[:, 10:12]
+    norm = along.norm(dim=1, keepdim=True)
+    along = torch.where(norm > 1e-6, along / norm.clamp_min(1e-6), torch.tensor([1.0, 0.0]))
+    R = torch.stack([along, torch.stack([-along[:, 1], along[:, 0]], dim=1)], dim=1)  # rows: along, across
+    rel = obs[..., :3] - contact[:, None, :]
+    turned = [torch.einsum("bij,bnj->bni", R, obs[..., k:k + 2] if k else rel[..., :2]) for k in (0, 3, 6)]
+    return torch.cat([turned[0] * 10.0, rel[..., 2:3] * 10.0, turned[1], obs[..., 5:6], turned[2] * 20.0,
+                      obs[..., 8:9] * 20.0, rel.norm(dim=-1, keepdim=True) * 10.0, obs[..., :3] * 10.0], dim=-1)
+
+
 class _Member(nn.Module):
     """One PointNet of the ensemble: logit from scaled points ``(B, N, 9)`` and decision features
     ``(B, n_decision)``."""
@@ -99,13 +129,21 @@ class SuccessNet(nn.Module):
     The mean logit of ``members`` independently initialised and trained PointNets (a deep ensemble: it ranks
     outcomes better than any one member), then one Platt scaling of that mean. ``n_decision``: how many of
     :func:`decision_features` it reads, the first ones (13 for files fitted before the lever arm was added).
+    ``encoder``: what the members' point MLP reads: ``"cloud"``, the observation (:meth:`scaled`), or
+    ``"contact"``, the cloud seen from the policy's contact along its motion (:func:`contact_frame_input`), which
+    lets a max-pool over points weigh the geometry ahead of the fingertip. A file's encoder is read from its
+    first layer's width (9 or 13).
     """
 
-    def __init__(self, in_dim: int = OBS_DIM, width: int = 64, members: int = 1, n_decision: int = N_DECISION):
+    def __init__(self, width: int = 64, members: int = 1, n_decision: int = N_DECISION, encoder: str = "cloud"):
         super().__init__()
         if members < 1:
             raise InputError(f"an ensemble needs at least one member, got {members}")
+        if encoder not in ENCODERS:
+            raise InputError(f"unknown encoder {encoder!r}; expected one of {ENCODERS}")
         self.n_decision = n_decision
+        self.encoder = encoder
+        in_dim = _CONTACT_DIM if encoder == "contact" else _CLOUD_DIM
         self.members = nn.ModuleList(_Member(in_dim, width, n_decision) for _ in range(members))
         # Platt scaling, fitted after training: p = sigmoid(a * logit + b).
         self.register_buffer("platt", torch.tensor([1.0, 0.0]))
@@ -115,8 +153,12 @@ class SuccessNet(nn.Module):
         """The members' input: observation features at about unit scale (positions in dm, flow in 5 cm)."""
         return obs * torch.tensor([10, 10, 10, 1, 1, 1, 20, 20, 20.0])
 
+    def member_input(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+        """What the members' point MLP reads, ``(B, N, 9)`` or ``(B, N, 13)`` (see ``encoder``)."""
+        return contact_frame_input(obs, decision) if self.encoder == "contact" else self.scaled(obs)
+
     def logit(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
-        x = self.scaled(obs)
+        x = self.member_input(obs, decision)
         decision = decision[:, :self.n_decision]
         return torch.stack([m(x, decision) for m in self.members]).mean(dim=0)
 
@@ -130,8 +172,9 @@ class SuccessNet(nn.Module):
         if any(k.startswith(("points.", "head.")) for k in state):
             state = {(k if k == "platt" else f"members.0.{k}"): v for k, v in state.items()}
         members = 1 + max(int(k.split(".")[1]) for k in state if k.startswith("members."))
-        width = state["members.0.points.0.weight"].shape[0]
-        net = cls(width=width, members=members, n_decision=state["members.0.head.0.weight"].shape[1] - 4 * width)
+        width, in_dim = state["members.0.points.0.weight"].shape
+        net = cls(width=width, members=members, n_decision=state["members.0.head.0.weight"].shape[1] - 4 * width,
+                  encoder="contact" if in_dim == _CONTACT_DIM else "cloud")
         net.load_state_dict(state)
         return net
 
@@ -455,9 +498,10 @@ class FrameViews:
 
 def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, lr: float = 1e-3,
         calib_fraction: float = 0.2, members: int = 1, progress: bool = True,
-        views: FrameViews | None = None) -> tuple[SuccessNet, dict]:
-    """Train a :class:`SuccessNet` of ``members`` PointNets on rollouts; Platt-scale it on a held-out share of
-    their objects. Every member sees the same training split, from its own initialisation and batch order.
+        views: FrameViews | None = None, encoder: str = "cloud") -> tuple[SuccessNet, dict]:
+    """Train a :class:`SuccessNet` of ``members`` PointNets (reading the ``encoder``'s input) on rollouts; Platt-scale
+    it on a held-out share of their objects. Every member sees the same training split, from its own
+    initialisation and batch order.
 
     ``views``: each training sample is seen in one of its frames drawn anew every epoch (:class:`FrameViews`);
     the calibration share is taken in the goal frame, as the model will be asked."""
@@ -467,8 +511,11 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
     calib_groups = rng.choice(groups, size=max(1, int(calib_fraction * len(groups))), replace=False)
     calib_mask = np.isin(data.group, calib_groups)
     train, calib = data.subset(~calib_mask), data.subset(calib_mask)
-    net = SuccessNet(members=members, n_decision=data.decision.shape[1])
-    x = SuccessNet.scaled(torch.from_numpy(train.obs.astype(np.float32)))
+    net = SuccessNet(members=members, n_decision=data.decision.shape[1], encoder=encoder)
+    x = torch.from_numpy(train.obs.astype(np.float32))
+    per_batch = encoder != "cloud"  # the contact frame depends on the decision, so on the view: built per batch
+    if not per_batch:
+        x = SuccessNet.scaled(x)  # scaling commutes with a view's rotation (uniform within each 3-vector)
     dec = torch.from_numpy(train.decision)
     y = torch.from_numpy(train.success.astype(np.float32))
     if views is not None:
@@ -492,7 +539,9 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
                     B = view_frames[b, k]
                     xb = torch.einsum("bij,bnkj->bnki", B, xb.view(*xb.shape[:2], -1, 3)).reshape(xb.shape)
                     db = view_dec[b, k]
-                loss = F.binary_cross_entropy_with_logits(member(xb, db), y[b])
+                if per_batch:
+                    xb = net.member_input(xb, db)
+                loss = F.binary_cross_entropy_with_logits(member(xb, db[:, :net.n_decision]), y[b])
                 opt.zero_grad()
                 loss.backward()
                 opt.step()
@@ -505,7 +554,7 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
     a_b = _platt(z, torch.from_numpy(calib.success.astype(np.float32)))
     net.platt.copy_(a_b)
     p_cal = torch.sigmoid(a_b[0] * z + a_b[1]).numpy()  # what net(...) now returns on the calibration set
-    return net, dict(train=len(train), calibration=len(calib), members=members, platt=a_b.tolist(),
+    return net, dict(train=len(train), calibration=len(calib), members=members, encoder=encoder, platt=a_b.tolist(),
                      calibration_metrics=metrics(p_cal, calib.success), frame_views=views is not None)
 
 
@@ -627,6 +676,10 @@ def build_parser() -> argparse.ArgumentParser:
                                       help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
     sub.choices["train"].add_argument("--epochs", type=int, default=40)
+    sub.choices["train"].add_argument("--encoder", choices=ENCODERS, default="cloud",
+                                      help="what the members' point MLP reads: the observation (cloud) or the cloud "
+                                           "seen from the policy's contact along its motion (contact; "
+                                           "contact_frame_input) (default: %(default)s)")
     sub.choices["train"].add_argument("--members", type=int, default=1,
                                       help="PointNets in the ensemble, their logits averaged (default: %(default)s)")
     return p
@@ -694,7 +747,7 @@ def _run(args: argparse.Namespace) -> int:
         data.save(cache)
         views = FrameViews.of(data, policy, args.skill, search, progress=not args.json) if args.views else None
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
-                        views=views)
+                        views=views, encoder=args.encoder)
         info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
                     policy=args.policy or "shipped")
         if searched:
@@ -708,7 +761,8 @@ def _run(args: argparse.Namespace) -> int:
                            + (f" --contrast-stand-ins {args.contrast_stand_ins}" if args.contrast_stand_ins else "")
                            + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
                            + (f" --model {args.model}" if searched and args.model else "")
-                           + (f" --workers {args.workers}" if args.workers > 1 else ""))
+                           + (f" --workers {args.workers}" if args.workers > 1 else "")
+                           + (f" --encoder {args.encoder}" if args.encoder != "cloud" else ""))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
         return 0

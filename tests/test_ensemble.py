@@ -9,10 +9,12 @@ from primitives import success
 from primitives.ensemble import StackedEnsemble
 
 
-@pytest.mark.parametrize("members,n_decision,batch", [(1, 13, 1), (5, 14, 1), (5, 14, 7), (3, 13, 4)])
-def test_stacked_ensemble_matches_the_net(members, n_decision, batch):
+@pytest.mark.parametrize("members,n_decision,batch,encoder", [(1, 13, 1, "cloud"), (5, 14, 1, "cloud"),
+                                                              (5, 14, 7, "cloud"), (3, 13, 4, "cloud"),
+                                                              (5, 14, 3, "contact"), (1, 14, 1, "contact")])
+def test_stacked_ensemble_matches_the_net(members, n_decision, batch, encoder):
     torch.manual_seed(members + batch)
-    net = success.SuccessNet(width=32, members=members, n_decision=n_decision).eval()
+    net = success.SuccessNet(width=32, members=members, n_decision=n_decision, encoder=encoder).eval()
     with torch.no_grad():
         net.platt.copy_(torch.tensor([1.3, -0.2]))
     rng = np.random.default_rng(batch)

@@ -238,6 +238,13 @@ def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
         with pytest.raises(SystemExit):
             success.main(["train", "spin", *bad, "--out", str(tmp_path / "no")])
     assert not (tmp_path / "no").exists()
+    # The same rollouts (from the cache) read by a contact-frame encoder: the file says so and loads as one.
+    rc = success.main(["train", "spin", "--contrast", "3", "--rollouts", "30", "--epochs", "1", "--seed", "1",
+                       "--encoder", "contact", "--out", str(tmp_path), "--json"])
+    assert rc == 0
+    info = torch.load(tmp_path / "success.pt", weights_only=False)["info"]
+    assert info["encoder"] == "contact" and info["command"].endswith("--encoder contact")
+    assert success.load_success_net("spin", tmp_path / "success.pt").encoder == "contact"
 
 
 def test_frame_contrast_rollouts_may_act_as_the_stand_in_requests():
@@ -323,3 +330,51 @@ def test_the_shipped_push_model_reads_the_lever_arm():
     other[:, 13] += 5.0  # the line 5 cm further from the centroid
     with torch.no_grad():
         assert not torch.allclose(net(obs, dec), net(obs, other))
+
+
+def test_the_contact_frame_sees_the_cloud_from_the_fingertip():
+    """Points are placed relative to the contact with x along the motion: the contact itself at the origin, a
+    point 1 cm ahead of it at x = 0.1 dm; turning the whole scene about the vertical changes nothing in the contact
+    frame, only the goal-frame positions the encoder also reads."""
+    rng = np.random.default_rng(3)
+    obs = rng.normal(0, 0.03, size=(1, 16, 9)).astype(np.float32)
+    obs[0, 1, :3] = obs[0, 0, :3] + [0.0, 0.01, 0.0]  # 1 cm from the contact along +y
+    decision = np.zeros((1, success.N_DECISION), np.float32)
+    decision[0, 4:7] = 10 * obs[0, 0, :3]  # the contact, in dm as decision_features gives it
+    decision[0, 10:13] = [0.0, 0.7, -0.2]  # the motion: along +y, a little down
+    x = success.contact_frame_input(torch.from_numpy(obs), torch.from_numpy(decision))[0]
+    assert x.shape == (16, 13)
+    assert torch.allclose(x[0, :3], torch.zeros(3), atol=1e-6) and float(x[0, 9]) == pytest.approx(0.0, abs=1e-6)
+    assert torch.allclose(x[1, :3], torch.tensor([0.1, 0.0, 0.0]), atol=1e-6)
+    assert float(x[1, 9]) == pytest.approx(0.1, abs=1e-6)
+    c, s = np.cos(0.7), np.sin(0.7)
+    Rz = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]], np.float32)
+    turned_obs = np.einsum("ij,bnkj->bnki", Rz, obs.reshape(1, 16, 3, 3)).reshape(1, 16, 9)
+    turned_dec = decision.copy()
+    turned_dec[0, 4:7] = Rz @ decision[0, 4:7]
+    turned_dec[0, 10:13] = Rz @ decision[0, 10:13]
+    y = success.contact_frame_input(torch.from_numpy(turned_obs), torch.from_numpy(turned_dec))[0]
+    assert torch.allclose(y[:, :10], x[:, :10], atol=1e-5)
+    assert not torch.allclose(y[:, 10:], x[:, 10:], atol=1e-3)
+
+
+def test_a_contact_encoder_learns_round_trips_and_answers_as_its_stacked_form(tmp_path):
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(4)
+    net, info = success.fit(_synthetic(1200, rng), seed=0, epochs=6, members=2, progress=False, encoder="contact")
+    assert net.encoder == "contact" and info["encoder"] == "contact"
+    test = _synthetic(600, rng)
+    obs, dec = torch.from_numpy(test.obs.astype(np.float32)), torch.from_numpy(test.decision)
+    with torch.no_grad():
+        p = net(obs, dec).numpy()
+    assert success.metrics(p, test.success)["auroc"] > 0.8
+    success.save(net, tmp_path / "c.pt", info)
+    again = success.load_success_net("spin", tmp_path / "c.pt")
+    assert again.encoder == "contact"
+    with torch.no_grad():
+        assert np.allclose(again(obs, dec).numpy(), p)
+    from primitives.ensemble import StackedEnsemble
+
+    assert np.allclose(StackedEnsemble(again)(obs, dec).numpy(), p, atol=1e-6)
+    with pytest.raises(success.InputError):
+        success.SuccessNet(encoder="voxels")
