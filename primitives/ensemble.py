@@ -34,7 +34,10 @@ class StackedEnsemble:
         self.n_members = len(members)
         self.width = first.weight.shape[0]
         self.n_decision = net.n_decision
-        self.contact = net.encoder == "contact"  # the members read contact_frame_input, not the scaled cloud
+        from primitives.success import contact_frame_input  # (success imports this module)
+
+        # The members' input: the contact frame (a function of the observation and the decision), or the scaled cloud.
+        self.contact_input = contact_frame_input if net.encoder == "contact" else None
         with torch.no_grad():
             # First point layer, all members at once: x (B*N, 9) @ (9, M*width).
             self.w_in = torch.cat([m.points[0].weight for m in members]).t().contiguous()
@@ -55,11 +58,9 @@ class StackedEnsemble:
                 or decision.shape[1] < self.n_decision:
             raise InputError(f"expected observations (B, N, 9) and decision features (B, >= {self.n_decision}), "
                              f"got {tuple(obs.shape)} and {tuple(decision.shape)}")
-        from primitives.success import contact_frame_input  # (success imports this module)
-
         b, n, _ = obs.shape
         m, w = self.n_members, self.width
-        x = (contact_frame_input(obs, decision) if self.contact else obs * self.scale).reshape(b * n, -1)
+        x = (obs * self.scale if self.contact_input is None else self.contact_input(obs, decision)).reshape(b * n, -1)
         h = torch.addmm(self.b_in, x, self.w_in).relu_().view(b * n, m, w).transpose(0, 1)  # (M, B*N, w)
         (w_pts, b_pts), *head = self.layers
         h = torch.baddbmm(b_pts, h, w_pts).relu_().view(m, b, n, -1)  # (M, B, N, 2w)

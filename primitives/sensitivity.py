@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import torch
+from scipy.spatial.transform import Rotation
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
@@ -140,8 +141,6 @@ class Sensitivity:
 
 def _turn_about_vertical(v: np.ndarray, angle: float) -> np.ndarray:
     """``v`` (world) turned by ``angle`` (rad) about the world z axis."""
-    from scipy.spatial.transform import Rotation
-
     return Rotation.from_rotvec([0.0, 0.0, angle]).apply(v)
 
 
