@@ -16,6 +16,8 @@ weights changed in the net after it is built are not seen. No gradients flow thr
 
 from __future__ import annotations
 
+from functools import partial
+
 import torch
 
 from affordplan.errors import InputError
@@ -34,10 +36,9 @@ class StackedEnsemble:
         self.n_members = len(members)
         self.width = first.weight.shape[0]
         self.n_decision = net.n_decision
-        from primitives.success import contact_frame_input  # (success imports this module)
+        from primitives.success import member_input  # (success imports this module)
 
-        # The members' input: the contact frame (a function of the observation and the decision), or the scaled cloud.
-        self.contact_input = contact_frame_input if net.encoder == "contact" else None
+        self.member_input = partial(member_input, net.encoder)  # what the members read, from (obs, decision)
         with torch.no_grad():
             # First point layer, all members at once: x (B*N, 9) @ (9, M*width).
             self.w_in = torch.cat([m.points[0].weight for m in members]).t().contiguous()
@@ -47,7 +48,6 @@ class StackedEnsemble:
                             torch.stack([layer(m).bias for m in members])[:, None, :].clone())
                            for layer in (lambda m: m.points[2], lambda m: m.head[0], lambda m: m.head[2],
                                          lambda m: m.head[4])]
-            self.scale = net.scaled(torch.ones(1, 1, 9)).reshape(-1).clone()
             self.platt = net.platt.clone()
 
     @torch.no_grad()
@@ -60,7 +60,7 @@ class StackedEnsemble:
                              f"got {tuple(obs.shape)} and {tuple(decision.shape)}")
         b, n, _ = obs.shape
         m, w = self.n_members, self.width
-        x = (obs * self.scale if self.contact_input is None else self.contact_input(obs, decision)).reshape(b * n, -1)
+        x = self.member_input(obs, decision).reshape(b * n, -1)
         h = torch.addmm(self.b_in, x, self.w_in).relu_().view(b * n, m, w).transpose(0, 1)  # (M, B*N, w)
         (w_pts, b_pts), *head = self.layers
         h = torch.baddbmm(b_pts, h, w_pts).relu_().view(m, b, n, -1)  # (M, B, N, 2w)

@@ -108,6 +108,12 @@ def contact_frame_input(obs: torch.Tensor, decision: torch.Tensor) -> torch.Tens
                       obs[..., 8:9] * 20.0, rel.norm(dim=-1, keepdim=True) * 10.0, obs[..., :3] * 10.0], dim=-1)
 
 
+def member_input(encoder: str, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+    """What a success net's members read for ``encoder`` (:data:`ENCODERS`): the scaled observation
+    (:meth:`SuccessNet.scaled`, ``(B, N, 9)``) or the contact frame (:func:`contact_frame_input`, ``(B, N, 13)``)."""
+    return contact_frame_input(obs, decision) if encoder == "contact" else SuccessNet.scaled(obs)
+
+
 class _Member(nn.Module):
     """One PointNet of the ensemble: logit from scaled points ``(B, N, 9)`` and decision features
     ``(B, n_decision)``."""
@@ -155,7 +161,7 @@ class SuccessNet(nn.Module):
 
     def member_input(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
         """What the members' point MLP reads, ``(B, N, 9)`` or ``(B, N, 13)`` (see ``encoder``)."""
-        return contact_frame_input(obs, decision) if self.encoder == "contact" else self.scaled(obs)
+        return member_input(self.encoder, obs, decision)
 
     def logit(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
         x = self.member_input(obs, decision)
@@ -541,7 +547,7 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
                     db = view_dec[b, k]
                 if per_batch:
                     xb = net.member_input(xb, db)
-                loss = F.binary_cross_entropy_with_logits(member(xb, db[:, :net.n_decision]), y[b])
+                loss = F.binary_cross_entropy_with_logits(member(xb, db), y[b])
                 opt.zero_grad()
                 loss.backward()
                 opt.step()
