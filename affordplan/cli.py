@@ -128,7 +128,8 @@ def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
 def _cmd_bench_query(args: argparse.Namespace) -> int:
     from primitives.querybench import bench_queries, report
 
-    rows = bench_queries(tuple(args.skill), repeats=args.repeats, batch=args.batch, seed=args.seed)
+    rows = bench_queries(tuple(args.skill), repeats=args.repeats, batch=args.batch, seed=args.seed,
+                         weights_dir=args.weights_dir)
     print(json.dumps([r.as_dict() for r in rows], indent=2) if args.json else report(rows))
     return 0
 
@@ -372,7 +373,8 @@ def build_parser() -> argparse.ArgumentParser:
         description=_wrap("Median time of one P(success) query per skill, alone and in a batch as the planner "
                           "asks them, with the searched success model and with the frame search's own rating, on "
                           "1 and 2 torch threads."),
-        epilog="examples:\n  affordplan bench query\n  affordplan bench query --skill spin --repeats 300 --json",
+        epilog="examples:\n  affordplan bench query\n  affordplan bench query --skill spin --repeats 300 --json\n"
+               "  affordplan bench query --skill spin --weights-dir primitives/weights/candidates/spin_cframe",
         formatter_class=_formatter,
     )
     bq.add_argument("--skill", nargs="+", default=["push", "spin", "roll"], choices=["push", "spin", "roll"],
@@ -381,6 +383,9 @@ def build_parser() -> argparse.ArgumentParser:
     bq.add_argument("--batch", type=_positive_int, default=32, help="queries per batch (default: %(default)s)")
     bq.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     bq.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bq.add_argument("--weights-dir", default=None, metavar="DIR",
+                    help="time the skills of this folder's files (laid out like primitives/weights/, e.g. a "
+                         "candidate set) instead of the shipped ones; a skill without files there stays shipped")
     bq.set_defaults(func=_cmd_bench_query)
 
     bp = bench_sub.add_parser(

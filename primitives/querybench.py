@@ -10,11 +10,13 @@ observation, timed for
 
 with each rater a skill can use: the searched success model (one policy decision in the goal frame and the net)
 and the frame search's own rating (the policy and the success model in every free frame, then the best, Platt-
-scaled), on 1 and 2 torch threads. Medians of ``repeats`` runs; the cloud is the mug's, posed by ``seed``.
+scaled), on 1 and 2 torch threads. Medians of ``repeats`` runs; the cloud is the mug's, posed by ``seed``. The
+skills are the shipped ones, or a candidate set's (``weights_dir``, as :func:`primitives.skills.load_skill` reads it).
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,7 +34,7 @@ WARM_UP = 10  # untimed calls before each timing
 @dataclass
 class QueryTiming:
     skill: str
-    rater: str  # "searched model" or "frame search (M frames)"
+    rater: str  # "searched model", "frame search (M frames)" or, without a frame search, "success model (goal frame)"
     threads: int
     single_ms: float
     batched_ms: float  # per query, in a batch of ``batch``
@@ -43,13 +45,20 @@ class QueryTiming:
 
 
 def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batch: int = 32,
-                  threads: tuple[int, ...] = (1, 2), seed: int = 0) -> list[QueryTiming]:
-    """Time the skills' success queries (a parameter asked; see the module docstring)."""
+                  threads: tuple[int, ...] = (1, 2), seed: int = 0,
+                  weights_dir: str | os.PathLike | None = None) -> list[QueryTiming]:
+    """Time the skills' success queries (a parameter asked; see the module docstring).
+
+    Raises:
+        InputError: a count under 1, or an unusable ``weights_dir`` (before anything is timed).
+    """
     import affordplan as ap
     from primitives.skills import load_skill
 
     if repeats < 1 or batch < 1 or not threads or min(threads) < 1:
         raise InputError("repeats, batch and threads must be positive")
+    skills_of = {name: [load_skill(name, searched=searched, weights_dir=weights_dir) for searched in (True, False)]
+                 for name in skills}
     rng = np.random.default_rng(seed)
     sim = ap.Simulator(ap.load_object("mug"), seed=seed)
     sim.reset()
@@ -59,14 +68,14 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
     try:
         for name in skills:
             params = skill_params.sample(name, rng, sim.obj, state, p_params=1.0)
-            for searched in (True, False):
-                skill = load_skill(name, searched=searched)
+            for searched, skill in zip((True, False), skills_of[name]):
                 if searched and skill.searched_model is None:
                     continue
                 obs = skill_observation(sim, name, params, skill.n_points).obs
                 many = np.repeat(obs[None], batch, axis=0)
-                rater = ("searched model" if searched
-                         else f"frame search ({len(skill.frames(params))} frames)")
+                n_frames = len(skill.frames(params))
+                rater = ("searched model" if searched else f"frame search ({n_frames} frames)" if n_frames > 1
+                         else "success model (goal frame)")
                 for n in threads:
                     torch.set_num_threads(n)
                     single = bench_query(skill.success_probability_obs, obs[None], repeats, WARM_UP)

@@ -133,7 +133,8 @@ class Sensitivity:
         ax2.set_xticks(range(len(aucs)), list(aucs), rotation=15)
         ax2.set_ylim(0.5, 1.0)
         ax2.set_ylabel("within-start AUROC")
-        fig.suptitle(f"{self.skill}, params {self.params}: {len(self.starts)} starts")
+        fig.suptitle(f"{self.skill}, params {self.params}: {len(self.starts)} starts; motion turned "
+                     f"{np.degrees(self.motion_rad):g} deg, contact moved {1e3 * self.contact_m:g} mm")
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)

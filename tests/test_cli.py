@@ -354,3 +354,17 @@ def test_run_scene_refuses_a_primitive_budget_that_is_not_a_whole_number(max_pri
     with pytest.raises(InputError, match="max_primitives must be a whole number >= 1"):
         run_scene(demo_scene(), tmp_path, max_primitives=max_primitives, video=False, progress=False)
     assert not any(tmp_path.iterdir())  # refused before anything was written
+
+
+def test_bench_query_times_a_candidate_folder_and_refuses_a_missing_one(capsys, tmp_path):
+    from primitives.skills import WEIGHTS_DIR
+
+    for name in ("spin.pt", "spin_success.pt"):  # a set without a frame search or a searched model
+        (tmp_path / name).write_bytes((WEIGHTS_DIR / name).read_bytes())
+    assert cli.main(["bench", "query", "--skill", "spin", "--repeats", "2", "--batch", "2", "--json",
+                     "--weights-dir", str(tmp_path)]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert {r["rater"] for r in rows} == {"success model (goal frame)"}  # the shipped spin has both
+    assert cli.main(["bench", "query", "--weights-dir", str(tmp_path / "nowhere")]) == 2
+    captured = capsys.readouterr()
+    assert "is not a folder" in captured.err and captured.out == ""
