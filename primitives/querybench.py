@@ -57,15 +57,16 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
 
     if repeats < 1 or batch < 1 or not threads or min(threads) < 1:
         raise InputError("repeats, batch and threads must be positive")
-    skills_of = {name: [load_skill(name, searched=searched, weights_dir=weights_dir) for searched in (True, False)]
-                 for name in skills}
-    rng = np.random.default_rng(seed)
-    sim = ap.Simulator(ap.load_object("mug"), seed=seed)
-    sim.reset()
-    state = sim.obj.classify(sim.object_pose())
-    before = torch.get_num_threads()
-    rows = []
+    before = torch.get_num_threads()  # loading a skill caps it at 2; put back when done, whatever happens
+    rows, sim = [], None
     try:
+        # every skill first, so that an unusable weights_dir is refused before anything is timed
+        skills_of = {name: [load_skill(name, searched=searched, weights_dir=weights_dir)
+                            for searched in (True, False)] for name in skills}
+        rng = np.random.default_rng(seed)
+        sim = ap.Simulator(ap.load_object("mug"), seed=seed)
+        sim.reset()
+        state = sim.obj.classify(sim.object_pose())
         for name in skills:
             params = skill_params.sample(name, rng, sim.obj, state, p_params=1.0)
             for searched, skill in zip((True, False), skills_of[name]):
@@ -83,7 +84,8 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
                     rows.append(QueryTiming(name, rater, n, 1e3 * single, 1e3 * batched, batch))
     finally:
         torch.set_num_threads(before)
-        sim.close()
+        if sim is not None:
+            sim.close()
     return rows
 
 

@@ -368,3 +368,21 @@ def test_bench_query_times_a_candidate_folder_and_refuses_a_missing_one(capsys, 
     assert cli.main(["bench", "query", "--weights-dir", str(tmp_path / "nowhere")]) == 2
     captured = capsys.readouterr()
     assert "is not a folder" in captured.err and captured.out == ""
+
+
+def test_bench_query_puts_the_thread_count_back_when_it_refuses_a_folder(tmp_path):
+    import torch
+
+    from primitives.querybench import bench_queries
+    from primitives.skills import WEIGHTS_DIR
+
+    for name in ("spin.pt", "spin_success.pt", "push.pt"):  # spin loads (and caps the threads); push has no model
+        (tmp_path / name).write_bytes((WEIGHTS_DIR / name).read_bytes())
+    before = torch.get_num_threads()
+    torch.set_num_threads(3)  # more than loading a skill allows
+    try:
+        with pytest.raises(InputError, match="no success model beside it"):
+            bench_queries(("spin", "push"), weights_dir=tmp_path)
+        assert torch.get_num_threads() == 3
+    finally:
+        torch.set_num_threads(before)
