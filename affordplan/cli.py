@@ -129,7 +129,7 @@ def _cmd_bench_query(args: argparse.Namespace) -> int:
     from primitives.querybench import bench_queries, report
 
     rows = bench_queries(tuple(args.skill), repeats=args.repeats, batch=args.batch, seed=args.seed,
-                         weights_dir=args.weights_dir)
+                         weights_dir=args.weights_dir, rounds=args.rounds)
     print(json.dumps([r.as_dict() for r in rows], indent=2) if args.json else report(rows))
     return 0
 
@@ -372,7 +372,7 @@ def build_parser() -> argparse.ArgumentParser:
         "query", help="time the skills' success queries",
         description=_wrap("Median time of one P(success) query per skill, alone and in a batch as the planner "
                           "asks them, with the searched success model and with the frame search's own rating, on "
-                          "1 and 2 torch threads."),
+                          "1 and 2 torch threads; the skills' timings interleaved in rounds."),
         epilog="examples:\n  affordplan bench query\n  affordplan bench query --skill spin --repeats 300 --json\n"
                "  affordplan bench query --skill spin --weights-dir primitives/weights/candidates/spin_cframe",
         formatter_class=_formatter,
@@ -381,6 +381,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="skills to time (default: all three)")
     bq.add_argument("--repeats", type=_positive_int, default=100, help="timed queries each (default: %(default)s)")
     bq.add_argument("--batch", type=_positive_int, default=32, help="queries per batch (default: %(default)s)")
+    bq.add_argument("--rounds", type=_positive_int, default=10,
+                    help="interleave the skills' timings over this many rounds, so that a machine's drift falls on "
+                         "all of them alike (default: %(default)s)")
     bq.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     bq.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bq.add_argument("--weights-dir", default=None, metavar="DIR",

@@ -12,11 +12,18 @@ with each rater a skill can use: the searched success model (one policy decision
 and the frame search's own rating (the policy and the success model in every free frame, then the best, Platt-
 scaled), on 1 and 2 torch threads. Medians of ``repeats`` runs; the cloud is the mug's, posed by ``seed``. The
 skills are the shipped ones, or a candidate set's (``weights_dir``, as :func:`primitives.skills.load_skill` reads it).
+
+The timings are **interleaved**: the ``repeats`` of every cell (skill, rater, thread count) are split into
+``rounds``, and each round times a share of every cell in turn. A shared machine's speed drifts from minute to
+minute (up to 1.5x on the 2-core development machine); timed one after another, that drift would show as a
+difference between skills, interleaved it falls on all of them alike. Each row also gives the fastest and
+slowest round's median of one query, how far the machine moved during the run.
 """
 
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +32,6 @@ import torch
 from affordplan.errors import InputError
 from primitives import params as skill_params
 from primitives.env import PRIMITIVES, skill_observation
-from primitives.success import bench_query
 
 TARGET_MS = 5.0  # issue target: one query under 5 ms on 2 cores
 WARM_UP = 10  # untimed calls before each timing
@@ -39,6 +45,7 @@ class QueryTiming:
     single_ms: float
     batched_ms: float  # per query, in a batch of ``batch``
     batch: int
+    single_ms_rounds: tuple[float, float] = (float("nan"), float("nan"))  # fastest, slowest round's median
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -46,8 +53,8 @@ class QueryTiming:
 
 def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batch: int = 32,
                   threads: tuple[int, ...] = (1, 2), seed: int = 0,
-                  weights_dir: str | os.PathLike | None = None) -> list[QueryTiming]:
-    """Time the skills' success queries (a parameter asked; see the module docstring).
+                  weights_dir: str | os.PathLike | None = None, rounds: int = 10) -> list[QueryTiming]:
+    """Time the skills' success queries (a parameter asked; see the module docstring), interleaved over ``rounds``.
 
     Raises:
         InputError: a count under 1, or an unusable ``weights_dir`` (before anything is timed).
@@ -55,10 +62,11 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
     import affordplan as ap
     from primitives.skills import load_skill
 
-    if repeats < 1 or batch < 1 or not threads or min(threads) < 1:
-        raise InputError("repeats, batch and threads must be positive")
+    if repeats < 1 or batch < 1 or rounds < 1 or not threads or min(threads) < 1:
+        raise InputError("repeats, batch, rounds and threads must be positive")
+    rounds = min(rounds, repeats)
     before = torch.get_num_threads()  # loading a skill caps it at 2; put back when done, whatever happens
-    rows, sim = [], None
+    sim = None
     try:
         # every skill first, so that an unusable weights_dir is refused before anything is timed
         skills_of = {name: [load_skill(name, searched=searched, weights_dir=weights_dir)
@@ -67,21 +75,33 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
         sim = ap.Simulator(ap.load_object("mug"), seed=seed)
         sim.reset()
         state = sim.obj.classify(sim.object_pose())
+        cells = []  # (skill, rater, threads, query, one observation, a batch of them)
         for name in skills:
             params = skill_params.sample(name, rng, sim.obj, state, p_params=1.0)
             for searched, skill in zip((True, False), skills_of[name]):
                 if searched and skill.searched_model is None:
                     continue
                 obs = skill_observation(sim, name, params, skill.n_points).obs
-                many = np.repeat(obs[None], batch, axis=0)
                 n_frames = len(skill.frames(params))
                 rater = ("searched model" if searched else f"frame search ({n_frames} frames)" if n_frames > 1
                          else "success model (goal frame)")
-                for n in threads:
-                    torch.set_num_threads(n)
-                    single = bench_query(skill.success_probability_obs, obs[None], repeats, WARM_UP)
-                    batched = bench_query(skill.success_probability_obs, many, max(3, repeats // 10), WARM_UP) / batch
-                    rows.append(QueryTiming(name, rater, n, 1e3 * single, 1e3 * batched, batch))
+                cells += [(name, rater, n, skill.success_probability_obs, obs[None],
+                           np.repeat(obs[None], batch, axis=0)) for n in threads]
+        single = [[] for _ in cells]  # per cell, per round: seconds of each timed call
+        batched = [[] for _ in cells]
+        per_round, per_round_batched = max(1, -(-repeats // rounds)), max(1, -(-max(3, repeats // 10) // rounds))
+        for r in range(rounds):
+            for c, (_, _, n, query, one, many) in enumerate(cells):
+                torch.set_num_threads(n)
+                warm_up = WARM_UP if r == 0 else 1
+                single[c].append(time_calls(query, one, per_round, warm_up))
+                batched[c].append(time_calls(query, many, per_round_batched, warm_up))
+        rows = []
+        for c, (name, rater, n, *_) in enumerate(cells):
+            medians = [1e3 * float(np.median(t)) for t in single[c]]
+            rows.append(QueryTiming(name, rater, n, 1e3 * float(np.median(np.concatenate(single[c]))),
+                                    1e3 * float(np.median(np.concatenate(batched[c]))) / batch, batch,
+                                    (min(medians), max(medians))))
     finally:
         torch.set_num_threads(before)
         if sim is not None:
@@ -89,11 +109,26 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
     return rows
 
 
+def time_calls(query, x: np.ndarray, n: int, warm_up: int = 1) -> np.ndarray:
+    """Seconds of each of ``n`` calls ``query(x)``, after ``warm_up`` untimed ones."""
+    for _ in range(warm_up):
+        query(x)
+    times = np.empty(n)
+    for i in range(n):
+        t = time.perf_counter()
+        query(x)
+        times[i] = time.perf_counter() - t
+    return times
+
+
 def report(rows: list[QueryTiming]) -> str:
-    lines = [f"{'skill':6s} {'rater':26s} {'threads':>7s} {'one query':>10s} {'in a batch':>11s}",
-             "-" * 64]
+    lines = [f"{'skill':6s} {'rater':26s} {'threads':>7s} {'one query':>10s} {'rounds':>15s} {'in a batch':>11s}",
+             "-" * 80]
     for r in rows:
-        lines.append(f"{r.skill:6s} {r.rater:26s} {r.threads:7d} {r.single_ms:8.2f} ms {r.batched_ms:8.2f} ms")
-    lines.append(f"(median; 'in a batch': per query, {rows[0].batch if rows else 0} queries a batch; "
+        lo, hi = r.single_ms_rounds
+        lines.append(f"{r.skill:6s} {r.rater:26s} {r.threads:7d} {r.single_ms:8.2f} ms {lo:6.2f}-{hi:5.2f} ms "
+                     f"{r.batched_ms:8.2f} ms")
+    lines.append(f"(median, the skills interleaved; 'rounds': the fastest and slowest round's median of one query; "
+                 f"'in a batch': per query, {rows[0].batch if rows else 0} queries a batch; "
                  f"target one query < {TARGET_MS:g} ms on 2 cores)")
     return "\n".join(lines)

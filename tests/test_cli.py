@@ -386,3 +386,25 @@ def test_bench_query_puts_the_thread_count_back_when_it_refuses_a_folder(tmp_pat
         assert torch.get_num_threads() == 3
     finally:
         torch.set_num_threads(before)
+
+
+def test_bench_query_interleaves_the_skills_in_rounds(monkeypatch):
+    import primitives.querybench as qb
+
+    order = []
+    real = qb.time_calls
+
+    def recording(query, x, n, warm_up=1):
+        order.append(query.__self__.name)
+        return real(query, x, n, warm_up)
+
+    monkeypatch.setattr(qb, "time_calls", recording)
+    rows = qb.bench_queries(("spin", "push"), repeats=3, batch=2, threads=(1,), rounds=3)
+    # each round times every cell (2 raters x one and a batch) of spin, then of push; three rounds
+    assert order == (["spin"] * 4 + ["push"] * 4) * 3
+    assert len(rows) == 4 and {r.skill for r in rows} == {"spin", "push"}
+    for r in rows:  # the median of all calls lies between the fastest and the slowest round's median
+        lo, hi = r.single_ms_rounds
+        assert 0 < lo <= r.single_ms <= hi
+    with pytest.raises(InputError, match="rounds"):
+        qb.bench_queries(("spin",), rounds=0)
