@@ -15,15 +15,16 @@ skills are the shipped ones, or a candidate set's (``weights_dir``, as :func:`pr
 
 The timings are **interleaved**: the ``repeats`` of every cell (skill, rater, thread count) are split into
 ``rounds``, and each round times a share of every cell in turn. A shared machine's speed drifts from minute to
-minute (up to 1.5x on the 2-core development machine); timed one after another, that drift would show as a
-difference between skills, interleaved it falls on all of them alike. Each row also gives the fastest and
-slowest round's median of one query, how far the machine moved during the run.
+minute (by up to 2x within five minutes on the 2-core development machine); timed one after another, that
+drift would show as a difference between skills, interleaved it falls on all of them alike. Each row also
+gives the fastest and slowest round's median of one query, how far the machine moved during the run.
 """
 
 from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -109,7 +110,7 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
     return rows
 
 
-def time_calls(query, x: np.ndarray, n: int, warm_up: int = 1) -> np.ndarray:
+def time_calls(query: Callable[[np.ndarray], np.ndarray], x: np.ndarray, n: int, warm_up: int = 1) -> np.ndarray:
     """Seconds of each of ``n`` calls ``query(x)``, after ``warm_up`` untimed ones."""
     for _ in range(warm_up):
         query(x)
