@@ -23,8 +23,6 @@ gives the fastest and slowest round's median of one query, how far the machine m
 from __future__ import annotations
 
 import os
-import time
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +31,7 @@ import torch
 from affordplan.errors import InputError
 from primitives import params as skill_params
 from primitives.env import PRIMITIVES, skill_observation
+from primitives.success import time_calls
 
 TARGET_MS = 5.0  # issue target: one query under 5 ms on 2 cores
 WARM_UP = 10  # untimed calls before each timing
@@ -46,7 +45,7 @@ class QueryTiming:
     single_ms: float
     batched_ms: float  # per query, in a batch of ``batch``
     batch: int
-    single_ms_rounds: tuple[float, float] = (float("nan"), float("nan"))  # fastest, slowest round's median
+    single_ms_rounds: tuple[float, float]  # the fastest and the slowest round's median of one query
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -90,7 +89,7 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
                            np.repeat(obs[None], batch, axis=0)) for n in threads]
         single = [[] for _ in cells]  # per cell, per round: seconds of each timed call
         batched = [[] for _ in cells]
-        per_round, per_round_batched = max(1, -(-repeats // rounds)), max(1, -(-max(3, repeats // 10) // rounds))
+        per_round, per_round_batched = -(-repeats // rounds), -(-max(3, repeats // 10) // rounds)  # ceilings
         for r in range(rounds):
             for c, (_, _, n, query, one, many) in enumerate(cells):
                 torch.set_num_threads(n)
@@ -108,18 +107,6 @@ def bench_queries(skills: tuple[str, ...] = PRIMITIVES, repeats: int = 100, batc
         if sim is not None:
             sim.close()
     return rows
-
-
-def time_calls(query: Callable[[np.ndarray], np.ndarray], x: np.ndarray, n: int, warm_up: int = 1) -> np.ndarray:
-    """Seconds of each of ``n`` calls ``query(x)``, after ``warm_up`` untimed ones."""
-    for _ in range(warm_up):
-        query(x)
-    times = np.empty(n)
-    for i in range(n):
-        t = time.perf_counter()
-        query(x)
-        times[i] = time.perf_counter() - t
-    return times
 
 
 def report(rows: list[QueryTiming]) -> str:

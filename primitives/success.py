@@ -601,17 +601,23 @@ def load_success_net(skill: str, path: str | os.PathLike | None = None) -> Succe
     return net.eval()
 
 
-def bench_query(predict, obs: np.ndarray, repeats: int = 200, warm_up: int = 1) -> float:
-    """Median seconds of ``predict(obs)`` (e.g. :meth:`SuccessModel.predict`: policy decision + success net) over
-    ``repeats`` calls, after ``warm_up`` untimed ones (lazy loading, the allocator)."""
+def time_calls(predict, obs: np.ndarray, repeats: int, warm_up: int = 1) -> np.ndarray:
+    """Seconds of each of ``repeats`` calls ``predict(obs)``, after ``warm_up`` untimed ones (lazy loading, the
+    allocator)."""
     for _ in range(warm_up):
         predict(obs)
-    times = []
-    for _ in range(repeats):
+    times = np.empty(repeats)
+    for i in range(repeats):
         t = time.perf_counter()
         predict(obs)
-        times.append(time.perf_counter() - t)
-    return float(np.median(times))
+        times[i] = time.perf_counter() - t
+    return times
+
+
+def bench_query(predict, obs: np.ndarray, repeats: int = 200, warm_up: int = 1) -> float:
+    """Median seconds of ``predict(obs)`` (e.g. :meth:`SuccessModel.predict`: policy decision + success net) over
+    ``repeats`` calls (:func:`time_calls`)."""
+    return float(np.median(time_calls(predict, obs, repeats, warm_up)))
 
 
 # ----------------------------------------------------------------------------------- CLI
