@@ -12,14 +12,18 @@ protocol allow.
 
 For each start of the evaluation (:func:`primitives.evaluate.evaluate`'s starts: the same objects,
 states and poses for the same ``--seed``), the simulator is restored to the start before each of
-``CANDIDATES`` scripted pushes:
+``CANDIDATES`` scripted pushes (that many for each aim):
 
 - **contacts** from a dense cloud (2048 points; the policy sees 256): on the surface facing the push
   (normal against it by > 60 deg), the two nearest the line through the **centre of mass** along the
   push (which no policy sees) in each of four height bands;
 - **motions**: along the push, 0.6-1.0 of the full 9 cm stroke, level or pressing down;
 - **directions**: the asked one (``--params random``), or eight around the circle (``--params none``,
-  where the seed's objective takes any direction; fewer contacts and strokes per direction).
+  where the seed's objective takes any direction; fewer contacts and strokes per direction);
+- **aims** (``--aim-deg 5 10``, with a direction only): the same pushes also along the asked direction turned
+  by each of these angles either way, contacts nearest the line through the centre of mass along the turned
+  push. A push is judged by the *asked* direction (within 15 deg), so a push aimed a little to one side may
+  meet it where the straight one turns the object.
 
 A start counts when any candidate meets the criterion. This is a bound from below on what a policy
 could reach with this fingertip and protocol (a cleverer candidate may exist), and the shipped policy's
@@ -38,7 +42,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError
+from affordplan.errors import AffordplanError, InputError
 from affordplan.sim.simulator import Simulator
 from primitives import rewards
 from primitives.env import PrimitiveEnv
@@ -47,7 +51,7 @@ from primitives.scripted import facing_and_offset
 
 CLOUD_POINTS = 2048
 HEIGHT_BANDS = ((0.05, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.95))  # fractions of the object's height
-CANDIDATES = 64  # per start, at most (fewer where a height band has no facing points)
+CANDIDATES = 64  # per start and aim, at most (fewer where a height band has no facing points)
 
 
 @dataclass(frozen=True)
@@ -79,12 +83,18 @@ def push_candidates(points: np.ndarray, normals: np.ndarray, com: np.ndarray, di
     return out
 
 
-def candidates_for(sim: Simulator, params: dict | None, rng: np.random.Generator) -> list[Candidate]:
-    """The scripted pushes tried from the simulator's current state (see the module docstring)."""
+def candidates_for(sim: Simulator, params: dict | None, rng: np.random.Generator,
+                   aims: tuple[float, ...] = ()) -> list[Candidate]:
+    """The scripted pushes tried from the simulator's current state (see the module docstring).
+
+    ``aims``: with a direction, also push along it turned by each of these angles (radians, > 0) either way.
+    """
     points, normals = sim.point_cloud(CLOUD_POINTS)
     com = sim.object_pose()[:3, 3]  # the object's body frame sits at its centre of mass
     if params is not None:
-        return push_candidates(points, normals, com, params["direction"], 2, (0.6, 0.7, 0.85, 1.0), (0.0, 0.5))
+        turns = (0.0,) + tuple(sign * a for a in aims for sign in (1.0, -1.0))
+        return [c for turn in turns for c in push_candidates(points, normals, com, params["direction"] + turn, 2,
+                                                             (0.6, 0.7, 0.85, 1.0), (0.0, 0.5))]
     offset = rng.uniform(0.0, math.pi / 4)
     return [c for k in range(8)
             for c in push_candidates(points, normals, com, offset + k * math.pi / 4, 1, (0.7, 1.0), (0.0,))]
@@ -94,6 +104,7 @@ def candidates_for(sim: Simulator, params: dict | None, rng: np.random.Generator
 class CeilingResult:
     starts: int
     params: str
+    aims_deg: list[float] = field(default_factory=list)  # turns of the asked direction also pushed along, either way
     any_success: int = 0  # starts where some candidate succeeded
     policy_success: int = 0  # starts where the shipped policy's greedy push succeeded
     candidate_success: list[float] = field(default_factory=list)  # per start, share of candidates that succeeded
@@ -115,7 +126,8 @@ class CeilingResult:
         return d
 
     def report(self) -> str:
-        lines = [f"push ({self.params}): {self.starts} held-out starts",
+        aims = f", also aimed {', '.join(f'+-{a:g}' for a in self.aims_deg)} deg" if self.aims_deg else ""
+        lines = [f"push ({self.params}): {self.starts} held-out starts{aims}",
                  f"  best of scripted pushes (privileged COM, dense cloud): {self.ceiling:.3f}",
                  f"  shipped policy, greedy, same starts:                   {self.policy:.3f}",
                  f"  share of scripted pushes that succeed, mean over starts: {np.mean(self.candidate_success):.3f}",
@@ -126,19 +138,23 @@ class CeilingResult:
 
 
 def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, weights=None,
-                 progress: bool = True) -> CeilingResult:
-    """Best-of-scripted-pushes success on the evaluation's held-out starts (module docstring)."""
+                 progress: bool = True, aims: tuple[float, ...] = ()) -> CeilingResult:
+    """Best-of-scripted-pushes success on the evaluation's held-out starts (module docstring); ``aims``: the
+    turns of the asked direction also pushed along, radians (:func:`candidates_for`)."""
+    if any(not (0.0 < a < math.radians(15.0)) for a in aims):
+        raise InputError(f"aims must lie strictly between 0 and 15 deg (the criterion's tolerance), got "
+                         f"{[round(math.degrees(a), 3) for a in aims]} deg")
     p_params = 1.0 if params == "random" else 0.0
     env = PrimitiveEnv(held_out_config("push", p_params), seed=seed)  # the evaluation's starts
     model = load_policy(weights, "push")
     rng = np.random.default_rng(seed)
-    result = CeilingResult(starts, params)
+    result = CeilingResult(starts, params, [math.degrees(a) for a in aims] if params == "random" else [])
     for _ in tqdm(range(starts), desc="push ceiling", disable=not progress, unit="start", mininterval=2.0):
         obs = env.reset()
         sim, prm = env.sim, env.params
         start = sim.snapshot()
         wins = 0
-        cands = candidates_for(sim, prm, rng)
+        cands = candidates_for(sim, prm, rng, aims if prm is not None else ())
         for c in cands:
             sim.restore(start)
             out = sim.execute(c.contact, c.motion, normal=c.normal)
@@ -169,6 +185,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="random: a push direction is asked (default); none: the seed's objective, any direction")
     p.add_argument("--seed", type=int, default=1234, help="the evaluation's seed: same starts (default: 1234)")
     p.add_argument("--weights", default=None, help="push policy to compare with (default: shipped)")
+    p.add_argument("--aim-deg", type=float, nargs="*", default=[], metavar="DEG",
+                   help="with a direction, also push along it turned by each of these angles either way, "
+                        "deg in (0, 15) (default: none)")
     p.add_argument("--json", action="store_true")
     return p
 
@@ -180,7 +199,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--starts must be a positive integer, got {args.starts}")
     torch.set_num_threads(1)
     try:
-        result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json)
+        result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json,
+                              aims=tuple(math.radians(a) for a in args.aim_deg))
     except AffordplanError as exc:  # missing or broken weights, ...
         print(f"primitives.ceiling: error: {exc}", file=sys.stderr)
         return 2

@@ -37,7 +37,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import torch
-from scipy.spatial.transform import Rotation
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
@@ -46,6 +45,7 @@ from primitives.env import PrimitiveEnv
 from primitives.evaluate import greedy_action, held_out_config, load_policy
 from primitives.frame_ceiling import add_held_out_arguments
 from primitives.frames import FrameSearch, load_frame_search
+from primitives.neighbours import CONTACT_M, MOTION_RAD, neighbour_decisions
 from primitives.networks import HybridActorCritic
 from primitives.success import SuccessModel, auroc, load_success_net
 
@@ -140,11 +140,6 @@ class Sensitivity:
         plt.close(fig)
 
 
-def _turn_about_vertical(v: np.ndarray, angle: float) -> np.ndarray:
-    """``v`` (world) turned by ``angle`` (rad) about the world z axis."""
-    return Rotation.from_rotvec([0.0, 0.0, angle]).apply(v)
-
-
 @torch.no_grad()
 def start_decisions(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSearch, predict, n_options: int,
                     rng: np.random.Generator, motion_rad: float, contact_m: float) -> StartDecisions:
@@ -164,16 +159,10 @@ def start_decisions(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameS
         idx, motion, _ = greedy_action(policy, acting.obs)
         contact, normal = acting.points[idx], acting.normals[idx]
         motion_world = acting.motion_to_world(motion)
-        along = np.cross(normal, [0.0, 0.0, 1.0])  # the surface's horizontal tangent at the contact
-        norm = np.linalg.norm(along)
-        along = along / norm if norm > 1e-6 else np.array([1.0, 0.0, 0.0])  # on a flat top, any: x
         shift = np.array([contact_m, 0.0, 0.0])
-        trials = [(contact, motion_world, None),
-                  (contact, _turn_about_vertical(motion_world, motion_rad), None),
-                  (contact, _turn_about_vertical(motion_world, -motion_rad), None),
-                  (contact + contact_m * along, motion_world, None),
-                  (contact - contact_m * along, motion_world, None),
-                  (contact + shift, motion_world, shift)]
+        trials = ([(contact, motion_world, None)]
+                  + [(c, m, None) for c, m in neighbour_decisions(contact, normal, motion_world, motion_rad, contact_m)]
+                  + [(contact + shift, motion_world, shift)])
         outcomes = []
         for point, motion_w, scene_shift in trials:
             sim.restore(start)
@@ -195,7 +184,7 @@ def start_decisions(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameS
 
 
 def sensitivity(skill: str, starts: int = 100, params: str = "random", options: int = 3, seed: int = 1234,
-                motion_rad: float = np.radians(3.0), contact_m: float = 0.002, weights=None, model=None,
+                motion_rad: float = MOTION_RAD, contact_m: float = CONTACT_M, weights=None, model=None,
                 frames: str = "shipped", progress: bool = True) -> Sensitivity:
     """The decisions of ``starts`` held-out starts of ``skill``, ``options`` drawn options each, and their variants
     (module docstring); ``params``: ``"random"`` asks for a random parameter, ``"none"`` the seed's objective.

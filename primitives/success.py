@@ -25,7 +25,9 @@ planner, which asks it often. Choices and why:
   parameter, 15 % the seed's objective); physics-guard failures are dropped as in training. With
   ``--contrast K`` each start is executed in K of the goal frames its request leaves free
   (:func:`collect_contrast`), so the model sees one start succeed in some frames and fail in others: what a
-  frame search (:mod:`primitives.frames`) asks of it is to rank one start's frames.
+  frame search (:mod:`primitives.frames`) asks of it is to rank one start's frames. With ``--neighbours`` each
+  such rollout's label is smoothed: the share of it and its four neighbours (:mod:`primitives.neighbours`) that
+  succeed, the part of a knife-edge outcome that the cloud and the decision can predict.
 - **Calibration.** After fitting (binary cross-entropy), Platt scaling (``sigmoid(a z + b)``) is fitted
   on rollouts from held-out *training* objects; figures are reported on the procedural *test* split,
   never seen by the policy or the model: ECE over 10 equal-width bins, Brier score, AUROC.
@@ -49,9 +51,11 @@ from torch import nn
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
+from primitives import rewards
 from primitives.ensemble import StackedEnsemble
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
+from primitives.neighbours import neighbour_decisions
 from primitives.networks import HybridActorCritic
 
 WEIGHTS_DIR = Path(__file__).parent / "weights"
@@ -216,27 +220,39 @@ class Rollouts:
     success: np.ndarray  # (n,) bool
     group: np.ndarray  # (n,) int: object id (for splits by object)
     parameterised: np.ndarray  # (n,) bool
+    # (n,) float32 in [0, 1]: a smoothed label, the share of the decision and its neighbours that succeed
+    # (primitives.neighbours); None: the outcome itself is the label
+    target: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.success)
 
+    def _arrays(self) -> tuple:
+        return (self.obs, self.decision, self.success, self.group, self.parameterised, self.target)
+
     def subset(self, mask: np.ndarray) -> Rollouts:
-        return Rollouts(*(a[mask] for a in (self.obs, self.decision, self.success, self.group, self.parameterised)))
+        return Rollouts(*(None if a is None else a[mask] for a in self._arrays()))
+
+    def labels(self) -> np.ndarray:
+        """What a model is fitted to, float32: the smoothed label where there is one, else the outcome."""
+        return (self.success if self.target is None else self.target).astype(np.float32)
 
     def save(self, path: str | os.PathLike) -> None:
+        extra = {} if self.target is None else {"target": self.target}
         np.savez_compressed(path, obs=self.obs, decision=self.decision, success=self.success, group=self.group,
-                            parameterised=self.parameterised)
+                            parameterised=self.parameterised, **extra)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Rollouts:
         z = np.load(path)
-        return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"])
+        return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"],
+                   z["target"] if "target" in z.files else None)
 
     @classmethod
     def concat(cls, parts: list[Rollouts]) -> Rollouts:
-        """The rollouts of ``parts``, in order."""
-        return cls(*(np.concatenate(a) for a in zip(*((r.obs, r.decision, r.success, r.group, r.parameterised)
-                                                        for r in parts))))
+        """The rollouts of ``parts``, in order (smoothed labels only where every part has them)."""
+        columns = list(zip(*(r._arrays() for r in parts)))
+        return cls(*(None if any(a is None for a in col) else np.concatenate(col) for col in columns))
 
 
 class _RolloutRows:
@@ -244,14 +260,18 @@ class _RolloutRows:
 
     def __init__(self):
         self.obs, self.decision, self.success, self.group, self.parameterised = [], [], [], [], []
+        self.target: list[float] = []
 
     def __len__(self) -> int:
         return len(self.success)
 
-    def add(self, obs: np.ndarray, decision: np.ndarray, success: bool, object_key, parameterised: bool) -> None:
+    def add(self, obs: np.ndarray, decision: np.ndarray, success: bool, object_key, parameterised: bool,
+            target: float | None = None) -> None:
         """One rollout: the observation acted on ``(N, 9)``, the decision features ``(13,)``, its outcome, the
-        object it was on (grouped by a stable hash of the key, for splits by object) and whether it had a
-        parameter."""
+        object it was on (grouped by a stable hash of the key, for splits by object), whether it had a
+        parameter, and optionally its smoothed label (:attr:`Rollouts.target`: give one for every rollout or none)."""
+        if target is not None:
+            self.target.append(target)
         self.obs.append(obs.astype(np.float16))
         self.decision.append(decision)
         self.success.append(success)
@@ -259,8 +279,11 @@ class _RolloutRows:
         self.parameterised.append(parameterised)
 
     def rollouts(self) -> Rollouts:
+        if self.target and len(self.target) != len(self.success):
+            raise ValueError("a smoothed label must be given for every rollout or for none")
+        target = np.array(self.target, dtype=np.float32) if self.target else None
         return Rollouts(np.stack(self.obs), np.stack(self.decision).astype(np.float32), np.array(self.success),
-                        np.array(self.group), np.array(self.parameterised))
+                        np.array(self.group), np.array(self.parameterised), target)
 
 
 @torch.no_grad()
@@ -321,7 +344,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
 @torch.no_grad()
 def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_start: int, split: str = "train",
                      n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
-                     progress: bool = True) -> Rollouts:
+                     progress: bool = True, neighbours: bool = False) -> Rollouts:
     """``n`` valid greedy rollouts of ``policy``, ``per_start`` from each start: the start seen in that many of the
     options ``search`` rates for its request (:meth:`primitives.frames.FrameSearch.options`: its free frames, and
     for the seed's objective with stand-ins each stand-in request in its own free frames), drawn without
@@ -333,6 +356,12 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     rollout of the policy on a start it could meet with that request (each free frame is one, primitives.frames),
     judged by that request's criterion (a stand-in request's own, not the seed's), so the model keeps its
     meaning, ``P(success | observation)``, and its calibration.
+
+    ``neighbours``: also execute each rollout's four neighbours (:func:`primitives.neighbours.neighbour_decisions`)
+    from the same state and store the share of the five that succeed (a guarded execution fails) as the rollout's
+    smoothed label (:attr:`Rollouts.target`). One decision's outcome can hang on a few millimetres; the share of
+    its neighbours is what a model of the cloud and the decision can predict, so a model fitted to it learns the
+    ranking of one start's options with less noise, at five simulations a rollout.
     """
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
@@ -354,11 +383,26 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
             res = env.step(int(idx[0]), motion[0].numpy().astype(np.float64))
             if not res.valid:
                 continue
-            rows.add(env.seen.obs, dec[0].numpy(), res.success, env.object_key, res.params is not None)
+            target = _neighbour_share(env, int(idx[0]), motion[0].numpy(), start, res.success) if neighbours else None
+            rows.add(env.seen.obs, dec[0].numpy(), res.success, env.object_key, res.params is not None, target)
             bar.update(1)
     bar.close()
     env.close()
     return rows.rollouts()
+
+
+def _neighbour_share(env: PrimitiveEnv, index: int, motion: np.ndarray, start, success: bool) -> float:
+    """The share of the decision (``index``, goal-frame ``motion``; its outcome ``success``) and its four neighbours
+    that succeed, each executed from the simulator state ``start`` and judged as ``env.step`` judges."""
+    seen, sim = env.seen, env.sim
+    wins = int(success)
+    for contact, motion_world in neighbour_decisions(seen.points[index], seen.normals[index],
+                                                     seen.motion_to_world(motion)):
+        sim.restore(start)
+        out = sim.execute(contact, motion_world, normal=seen.normals[index])
+        wins += bool(out.valid and rewards.success(env.config.primitive, out.pose_before, out.pose_after,
+                                                   seen.params, sim.obj))
+    return wins / 5.0
 
 
 def worker_seed(seed: int, worker: int) -> int:
@@ -523,7 +567,7 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
     if not per_batch:
         x = SuccessNet.scaled(x)  # scaling commutes with a view's rotation (uniform within each 3-vector)
     dec = torch.from_numpy(train.decision)
-    y = torch.from_numpy(train.success.astype(np.float32))
+    y = torch.from_numpy(train.labels())  # the outcomes, or their smoothed labels where the data carry them
     if views is not None:
         views = views.subset(~calib_mask)
         view_frames = torch.from_numpy(views.frames)
@@ -684,6 +728,11 @@ def build_parser() -> argparse.ArgumentParser:
                                            "the stand-in requests a frame search with --stand-ins N tries (push: N "
                                            "directions, a multiple of 12; spin, roll: any N > 0), each judged by its "
                                            "own criterion (default: 0, the seed's own frames only)")
+    sub.choices["train"].add_argument("--neighbours", action="store_true",
+                                      help="with --contrast: also execute each rollout's four neighbours (motion "
+                                           "turned 3 deg either way, contact moved 2 mm either way; "
+                                           "primitives.neighbours) and fit the model to the share of the five "
+                                           "that succeed; calibrated on the outcomes themselves")
     sub.choices["train"].add_argument("--model", default=None,
                                       help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
@@ -710,6 +759,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--contrast trains a goal-frame success model; --frames a searched one: give one")
     if getattr(args, "contrast_stand_ins", 0) and not args.contrast:
         parser.error("--contrast-stand-ins needs --contrast")
+    if getattr(args, "neighbours", False) and not args.contrast:
+        parser.error("--neighbours needs --contrast")
     if getattr(args, "workers", 1) < 1:
         parser.error(f"--workers must be a positive integer, got {args.workers}")
     if getattr(args, "members", 1) < 1:
@@ -740,6 +791,7 @@ def _run(args: argparse.Namespace) -> int:
         search = load_frame_search(args.skill, args.frames) if searched else None
         workers = f"_w{args.workers}" if args.workers > 1 else ""
         stand_ins = f"s{args.contrast_stand_ins}" if args.contrast_stand_ins else ""
+        stand_ins += "n" if args.neighbours else ""
         kind = "searched_" if searched else f"contrast{args.contrast}{stand_ins}_" if args.contrast else ""
         cache = out / f"train_{kind}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
         if cache.exists():
@@ -747,7 +799,8 @@ def _run(args: argparse.Namespace) -> int:
         elif contrast is not None:
             data = Rollouts.concat(collect_parallel(
                 collect_contrast, (policy, args.skill), args.rollouts, args.seed, args.workers,
-                progress=not args.json, search=contrast, per_start=args.contrast, split="train"))
+                progress=not args.json, search=contrast, per_start=args.contrast, split="train",
+                neighbours=args.neighbours))
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model))
             data = Rollouts.concat([part[1] for part in collect_parallel(
@@ -765,12 +818,13 @@ def _run(args: argparse.Namespace) -> int:
         if searched:
             info.update(frames=args.frames, model=args.model or "shipped")
         if args.contrast:
-            info.update(contrast=args.contrast, contrast_stand_ins=args.contrast_stand_ins)
+            info.update(contrast=args.contrast, contrast_stand_ins=args.contrast_stand_ins, neighbours=args.neighbours)
         info["command"] = ("python -m primitives.success train " + args.skill
                            + (f" --policy {args.policy}" if args.policy else "") + f" --rollouts {args.rollouts} "
                            f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
                            + (f" --contrast {args.contrast}" if args.contrast else "")
                            + (f" --contrast-stand-ins {args.contrast_stand_ins}" if args.contrast_stand_ins else "")
+                           + (" --neighbours" if args.neighbours else "")
                            + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
                            + (f" --model {args.model}" if searched and args.model else "")
                            + (f" --workers {args.workers}" if args.workers > 1 else "")

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import affordplan as ap
-from primitives import rewards
+from affordplan.errors import InputError
+from primitives import ceiling, rewards
 from primitives.ceiling import CLOUD_POINTS, candidates_for, push_candidates
 
 
@@ -27,6 +28,28 @@ def test_candidates_face_the_push_and_hug_the_centre_line(cube):
     assert np.allclose([c.motion[:2] / np.linalg.norm(c.motion[:2]) for c in cands], d[:2])
 
 
+def test_aimed_candidates_push_along_the_turned_direction(cube):
+    """With aims, each turn of the asked direction gets the straight candidates' set, along the turned push and
+    through the centre of mass along it; an aim outside (0, 15) deg is refused."""
+    sim = ap.Simulator(cube, seed=0)
+    T = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.3)
+    params = {"direction": math.radians(100.0)}
+    straight = candidates_for(sim, params, np.random.default_rng(0))
+    aim = math.radians(10.0)
+    aimed = candidates_for(sim, params, np.random.default_rng(0), aims=(aim,))
+    assert len(aimed) == 3 * len(straight)
+    headings = np.degrees([math.atan2(c.motion[1], c.motion[0]) for c in aimed])
+    assert sorted({round(h, 6) for h in headings}) == [90.0, 100.0, 110.0]
+    for c in aimed:
+        d = c.motion[:2] / np.linalg.norm(c.motion[:2])
+        rel = c.contact[:2] - T[:2, 3]
+        assert abs(rel[0] * d[1] - rel[1] * d[0]) < 0.01  # within 1 cm of the line through the COM along it
+        assert c.normal[:2] @ d < -0.5
+    for bad in (0.0, math.radians(15.0), math.nan):
+        with pytest.raises(InputError, match="aims"):
+            ceiling.push_ceiling(starts=1, aims=(bad,), progress=False)
+
+
 def test_a_centre_line_push_moves_the_cube_straight(cube):
     sim = ap.Simulator(cube, seed=0)
     sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
@@ -42,7 +65,7 @@ def test_a_centre_line_push_moves_the_cube_straight(cube):
 
 def test_bad_command_lines_get_a_clear_error_not_a_traceback(tmp_path, capsys):
     """Missing weights or a mesh that does not load: one line on stderr, exit status 2; no starts: a usage error."""
-    from primitives import ceiling, evaluate, success
+    from primitives import evaluate, success
 
     missing = str(tmp_path / "nope.pt")
     assert ceiling.main(["--starts", "1", "--weights", missing]) == 2

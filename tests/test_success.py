@@ -202,6 +202,49 @@ def test_frame_contrast_rollouts_execute_one_start_in_several_frames():
     assert np.array_equal(again.obs, data.obs) and np.array_equal(again.success, data.success)
 
 
+def test_smoothed_labels_share_the_outcomes_of_a_decision_and_its_neighbours(tmp_path):
+    """``collect_contrast(neighbours=True)``: the same rollouts and outcomes as without, each with the share of
+    it and its four neighbours that succeed as its label (so at least 1/5 where it succeeded, at most 4/5 where
+    it failed); the label is what ``fit`` reads, survives a save, a subset and a concat, and ``--neighbours`` needs
+    ``--contrast``."""
+    from primitives.skills import load_skill
+
+    policy = load_skill("spin", frame_search=False).success_model.policy
+    search = FrameSearch(4, False)
+    args = (policy, "spin", 12, search, 3, "train")
+    plain = success.collect_contrast(*args, n_objects=3, seed=1, p_params=1.0, progress=False)
+    data = success.collect_contrast(*args, n_objects=3, seed=1, p_params=1.0, progress=False, neighbours=True)
+    assert plain.target is None and data.target is not None
+    assert np.array_equal(plain.obs, data.obs) and np.array_equal(plain.success, data.success)
+    assert np.allclose(data.target * 5, np.round(data.target * 5))
+    assert (data.target[data.success] >= 0.2).all() and (data.target[~data.success] <= 0.8).all()
+    assert 0 < data.target.mean() < 1 and not np.array_equal(data.target, data.success.astype(np.float32))
+    assert np.array_equal(data.labels(), data.target) and np.array_equal(plain.labels(), plain.success)
+    data.save(tmp_path / "r.npz")
+    back = success.Rollouts.load(tmp_path / "r.npz")
+    assert np.array_equal(back.target, data.target)
+    assert np.array_equal(back.subset(back.success).target, data.target[data.success])
+    assert np.array_equal(success.Rollouts.concat([back, back]).target, np.tile(data.target, 2))
+    assert success.Rollouts.concat([back, plain]).target is None
+    with pytest.raises(SystemExit):
+        success.main(["train", "spin", "--neighbours", "--out", str(tmp_path / "no")])
+    assert not (tmp_path / "no").exists()
+
+
+def test_fit_reads_the_smoothed_labels():
+    """A model fitted to labels that say the opposite of the outcomes learns the labels."""
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(3)
+    data = _synthetic(1500, rng)
+    towards_x = data.obs[:, 0, 6].astype(np.float32) > 0
+    data.target = np.where(towards_x, 0.1, 0.9).astype(np.float32)  # the outcomes favour +x, the labels -x
+    net, _ = success.fit(data, seed=0, epochs=6, progress=False)
+    test = _synthetic(400, rng)
+    with torch.no_grad():
+        z = net.logit(torch.from_numpy(test.obs.astype(np.float32)), torch.from_numpy(test.decision)).numpy()
+    assert success.auroc(z, test.obs[:, 0, 6].astype(np.float32) < 0) > 0.95
+
+
 class _Twice(FrameSearch):
     """A frame search whose 'free frames' are the goal frame twice."""
 
