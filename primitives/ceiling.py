@@ -154,7 +154,7 @@ def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, we
         sim, prm = env.sim, env.params
         start = sim.snapshot()
         wins = 0
-        cands = candidates_for(sim, prm, rng, aims if prm is not None else ())
+        cands = candidates_for(sim, prm, rng, aims)  # aims apply to a direction only
         for c in cands:
             sim.restore(start)
             out = sim.execute(c.contact, c.motion, normal=c.normal)

@@ -40,12 +40,11 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
-from primitives import rewards
 from primitives.env import PrimitiveEnv
 from primitives.evaluate import greedy_action, held_out_config, load_policy
 from primitives.frame_ceiling import add_held_out_arguments
 from primitives.frames import FrameSearch, load_frame_search
-from primitives.neighbours import CONTACT_M, MOTION_RAD, neighbour_decisions
+from primitives.neighbours import CONTACT_M, MOTION_RAD, judged_execution, neighbour_outcomes
 from primitives.networks import HybridActorCritic
 from primitives.success import SuccessModel, auroc, load_success_net
 
@@ -159,20 +158,16 @@ def start_decisions(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameS
         idx, motion, _ = greedy_action(policy, acting.obs)
         contact, normal = acting.points[idx], acting.normals[idx]
         motion_world = acting.motion_to_world(motion)
-        shift = np.array([contact_m, 0.0, 0.0])
-        trials = ([(contact, motion_world, None)]
-                  + [(c, m, None) for c, m in neighbour_decisions(contact, normal, motion_world, motion_rad, contact_m)]
-                  + [(contact + shift, motion_world, shift)])
-        outcomes = []
-        for point, motion_w, scene_shift in trials:
-            sim.restore(start)
-            if scene_shift is not None:
-                T = T_world_object.copy()
-                T[:3, 3] += scene_shift
-                sim.set_object_pose(T, settle=False)
-            out = sim.execute(point, motion_w, normal=normal)
-            outcomes.append(bool(out.valid and rewards.success(skill, out.pose_before, out.pose_after,
-                                                               acting.params, sim.obj)))
+        sim.restore(start)
+        outcomes = [judged_execution(sim, skill, acting.params, contact, motion_world, normal)]
+        outcomes += neighbour_outcomes(sim, start, skill, acting.params, contact, normal, motion_world, motion_rad,
+                                       contact_m)
+        shift = np.array([contact_m, 0.0, 0.0])  # the scene shift: object and decision moved together along x
+        sim.restore(start)
+        T = T_world_object.copy()
+        T[:3, 3] += shift
+        sim.set_object_pose(T, settle=False)
+        outcomes.append(judged_execution(sim, skill, acting.params, contact + shift, motion_world, normal))
         parameterised = options[k][0].params is not None
         rating.append(float(search.calibrate_kind(ratings[k][j], parameterised)))
         base.append(outcomes[0])

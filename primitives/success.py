@@ -41,7 +41,7 @@ import os
 import sys
 import time
 import zlib
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -51,11 +51,10 @@ from torch import nn
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
-from primitives import rewards
 from primitives.ensemble import StackedEnsemble
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
-from primitives.neighbours import neighbour_decisions
+from primitives.neighbours import neighbour_outcomes
 from primitives.networks import HybridActorCritic
 
 WEIGHTS_DIR = Path(__file__).parent / "weights"
@@ -228,7 +227,8 @@ class Rollouts:
         return len(self.success)
 
     def _arrays(self) -> tuple:
-        return (self.obs, self.decision, self.success, self.group, self.parameterised, self.target)
+        """The columns, in field order (``target`` may be None)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
 
     def subset(self, mask: np.ndarray) -> Rollouts:
         return Rollouts(*(None if a is None else a[mask] for a in self._arrays()))
@@ -394,15 +394,10 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
 def _neighbour_share(env: PrimitiveEnv, index: int, motion: np.ndarray, start, success: bool) -> float:
     """The share of the decision (``index``, goal-frame ``motion``; its outcome ``success``) and its four neighbours
     that succeed, each executed from the simulator state ``start`` and judged as ``env.step`` judges."""
-    seen, sim = env.seen, env.sim
-    wins = int(success)
-    for contact, motion_world in neighbour_decisions(seen.points[index], seen.normals[index],
-                                                     seen.motion_to_world(motion)):
-        sim.restore(start)
-        out = sim.execute(contact, motion_world, normal=seen.normals[index])
-        wins += bool(out.valid and rewards.success(env.config.primitive, out.pose_before, out.pose_after,
-                                                   seen.params, sim.obj))
-    return wins / 5.0
+    seen = env.seen
+    wins = neighbour_outcomes(env.sim, start, env.config.primitive, seen.params, seen.points[index],
+                              seen.normals[index], seen.motion_to_world(motion))
+    return (int(success) + sum(wins)) / 5.0
 
 
 def worker_seed(seed: int, worker: int) -> int:
