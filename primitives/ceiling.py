@@ -44,9 +44,9 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
 from affordplan.sim.simulator import Simulator
-from primitives import rewards
 from primitives.env import PrimitiveEnv
 from primitives.evaluate import greedy_action, held_out_config, load_policy
+from primitives.neighbours import judged_execution
 from primitives.scripted import facing_and_offset
 
 CLOUD_POINTS = 2048
@@ -157,8 +157,7 @@ def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, we
         cands = candidates_for(sim, prm, rng, aims)  # aims apply to a direction only
         for c in cands:
             sim.restore(start)
-            out = sim.execute(c.contact, c.motion, normal=c.normal)
-            wins += bool(out.valid and rewards.success("push", out.pose_before, out.pose_after, prm, sim.obj))
+            wins += judged_execution(sim, "push", prm, c.contact, c.motion, c.normal)
         sim.restore(start)
         idx, motion, _ = greedy_action(model, obs)
         policy_ok = env.step(idx, motion).success
