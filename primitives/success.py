@@ -28,6 +28,10 @@ planner, which asks it often. Choices and why:
   frame search (:mod:`primitives.frames`) asks of it is to rank one start's frames. With ``--neighbours`` each
   such rollout's label is smoothed: the share of it and its four neighbours (:mod:`primitives.neighbours`) that
   succeed, the part of a knife-edge outcome that the cloud and the decision can predict.
+- **Ranking.** ``--rank-weight W`` adds W times a pairwise logistic loss over each frame-contrast start's
+  (success, failure) pairs to the cross-entropy, on batches of whole starts (:func:`fit`). A frame search picks
+  the option its model rates highest, so only the order within one start counts there; ``--rollouts-from`` fits
+  on rollouts that earlier runs saved, several files at once.
 - **Calibration.** After fitting (binary cross-entropy), Platt scaling (``sigmoid(a z + b)``) is fitted
   on rollouts from held-out *training* objects; figures are reported on the procedural *test* split,
   never seen by the policy or the model: ECE over 10 equal-width bins, Brier score, AUROC.
@@ -253,6 +257,20 @@ class Rollouts:
         """The rollouts of ``parts``, in order (smoothed labels only where every part has them)."""
         columns = list(zip(*(r._arrays() for r in parts)))
         return cls(*(None if any(a is None for a in col) else np.concatenate(col) for col in columns))
+
+
+def contrast_starts(obs: np.ndarray) -> np.ndarray:
+    """The start each rollout of ``obs`` ``(n, N, 9)`` was executed from, as an index ``(n,)`` counting up from 0.
+
+    :func:`collect_contrast` stores one start's rollouts one after another, and every option it executes a start
+    in is a turn about the vertical or a mirror of the goal frame, which keeps each point's height (column 2). So a
+    start is a run of consecutive rows whose clouds have the same sorted heights; rollouts collected one per start
+    (:func:`collect`) are each a start of their own. Needs no extra column, so it reads every cache file written
+    before it.
+    """
+    heights = np.sort(np.asarray(obs[:, :, 2], dtype=np.float32), axis=1)
+    new_start = np.r_[True, np.any(heights[1:] != heights[:-1], axis=1)] if len(heights) else np.zeros(0, bool)
+    return np.cumsum(new_start) - 1
 
 
 class _RolloutRows:
@@ -543,13 +561,22 @@ class FrameViews:
 
 def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, lr: float = 1e-3,
         calib_fraction: float = 0.2, members: int = 1, progress: bool = True,
-        views: FrameViews | None = None, encoder: str = "cloud") -> tuple[SuccessNet, dict]:
+        views: FrameViews | None = None, encoder: str = "cloud", rank_weight: float = 0.0) -> tuple[SuccessNet, dict]:
     """Train a :class:`SuccessNet` of ``members`` PointNets (reading the ``encoder``'s input) on rollouts; Platt-scale
     it on a held-out share of their objects. Every member sees the same training split, from its own
     initialisation and batch order.
 
     ``views``: each training sample is seen in one of its frames drawn anew every epoch (:class:`FrameViews`);
-    the calibration share is taken in the goal frame, as the model will be asked."""
+    the calibration share is taken in the goal frame, as the model will be asked.
+
+    ``rank_weight``: for frame-contrast rollouts, add ``rank_weight`` times a within-start ranking loss to the
+    binary cross-entropy: each batch holds whole starts (:func:`contrast_starts`; as many as make about
+    ``batch_size`` rollouts), and every pair of one start's rollouts where one succeeded and the other failed costs
+    ``softplus(z_fail - z_success)`` (a pairwise logistic loss on the logits, averaged over the batch's pairs). A
+    frame search needs the model to rank one start's options; cross-entropy alone fits the level across starts,
+    which the share of starts that succeed dominates."""
+    if not (np.isfinite(rank_weight) and rank_weight >= 0):
+        raise InputError(f"rank_weight must be a finite number >= 0, got {rank_weight}")
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
     groups = np.unique(data.group)
@@ -568,6 +595,10 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
         view_frames = torch.from_numpy(views.frames)
         view_dec = torch.from_numpy(views.decision[..., :net.n_decision])  # as many as the rollouts carry
         view_count = torch.from_numpy(views.count)
+    if rank_weight > 0:  # batches of whole starts
+        start = torch.from_numpy(contrast_starts(train.obs))
+        rows_of = np.split(np.arange(len(start)), np.flatnonzero(np.diff(start.numpy())) + 1)
+        starts_per_batch = max(1, round(batch_size * len(rows_of) / max(len(start), 1)))
     bar = tqdm(total=members * epochs, desc="fit success model", disable=not progress, unit="epoch")
     for k, member in enumerate(net.members):
         opt = torch.optim.Adam(member.parameters(), lr=lr, weight_decay=1e-5)
@@ -575,9 +606,14 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
         gen = torch.Generator().manual_seed(seed + 1000 * k)
         member.train()
         for _ in range(epochs):
-            perm = torch.randperm(len(y), generator=gen)
-            for i in range(0, len(y), batch_size):
-                b = perm[i:i + batch_size]
+            if rank_weight > 0:
+                order = torch.randperm(len(rows_of), generator=gen).numpy()
+                batches = [torch.from_numpy(np.concatenate([rows_of[j] for j in order[i:i + starts_per_batch]]))
+                           for i in range(0, len(order), starts_per_batch)]
+            else:
+                perm = torch.randperm(len(y), generator=gen)
+                batches = [perm[i:i + batch_size] for i in range(0, len(y), batch_size)]
+            for b in batches:
                 xb, db = x[b], dec[b]
                 if views is not None:  # each sample in a random frame of its group
                     k = (torch.rand(len(b), generator=gen) * view_count[b]).long()
@@ -586,7 +622,10 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
                     db = view_dec[b, k]
                 if per_batch:
                     xb = net.member_input(xb, db)
-                loss = F.binary_cross_entropy_with_logits(member(xb, db), y[b])
+                logit = member(xb, db)
+                loss = F.binary_cross_entropy_with_logits(logit, y[b])
+                if rank_weight > 0:
+                    loss = loss + rank_weight * pairwise_rank_loss(logit, y[b], start[b])
                 opt.zero_grad()
                 loss.backward()
                 opt.step()
@@ -600,7 +639,17 @@ def fit(data: Rollouts, seed: int = 0, epochs: int = 40, batch_size: int = 128, 
     net.platt.copy_(a_b)
     p_cal = torch.sigmoid(a_b[0] * z + a_b[1]).numpy()  # what net(...) now returns on the calibration set
     return net, dict(train=len(train), calibration=len(calib), members=members, encoder=encoder, platt=a_b.tolist(),
-                     calibration_metrics=metrics(p_cal, calib.success), frame_views=views is not None)
+                     calibration_metrics=metrics(p_cal, calib.success), frame_views=views is not None,
+                     rank_weight=rank_weight)
+
+
+def pairwise_rank_loss(logit: torch.Tensor, label: torch.Tensor, start: torch.Tensor) -> torch.Tensor:
+    """The mean of ``softplus(z_j - z_i)`` over pairs ``(i, j)`` of one start with ``label_i > label_j``: zero when
+    no start in the batch has two different labels."""
+    pair = (start[:, None] == start[None, :]) & (label[:, None] > label[None, :])
+    if not pair.any():
+        return logit.new_zeros(())
+    return F.softplus(logit[None, :] - logit[:, None])[pair].mean()
 
 
 def _platt(z: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
@@ -728,6 +777,14 @@ def build_parser() -> argparse.ArgumentParser:
                                            "turned 3 deg either way, contact moved 2 mm either way; "
                                            "primitives.neighbours) and fit the model to the share of the five "
                                            "that succeed; calibrated on the outcomes themselves")
+    sub.choices["train"].add_argument("--rank-weight", type=float, default=0.0, metavar="W",
+                                      help="add W times a within-start pairwise ranking loss to the cross-entropy "
+                                           "(fit: batches of whole frame-contrast starts); needs --contrast or "
+                                           "--rollouts-from (default: 0, cross-entropy alone)")
+    sub.choices["train"].add_argument("--rollouts-from", nargs="+", default=None, metavar="NPZ",
+                                      help="fit on these saved rollouts (the train_*.npz files earlier train runs "
+                                           "wrote), concatenated, instead of collecting; --rollouts, --seed and "
+                                           "--workers then only name the run, and --seed still seeds the fit")
     sub.choices["train"].add_argument("--model", default=None,
                                       help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
@@ -756,6 +813,13 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--contrast-stand-ins needs --contrast")
     if getattr(args, "neighbours", False) and not args.contrast:
         parser.error("--neighbours needs --contrast")
+    if getattr(args, "rank_weight", 0.0) and not (args.contrast or args.rollouts_from):
+        parser.error("--rank-weight needs frame-contrast rollouts: give --contrast or --rollouts-from")
+    if not np.isfinite(getattr(args, "rank_weight", 0.0)) or getattr(args, "rank_weight", 0.0) < 0:
+        parser.error(f"--rank-weight must be a finite number >= 0, got {args.rank_weight}")
+    for path in getattr(args, "rollouts_from", None) or ():
+        if not Path(path).is_file():
+            parser.error(f"--rollouts-from: no file {path}")
     if getattr(args, "workers", 1) < 1:
         parser.error(f"--workers must be a positive integer, got {args.workers}")
     if getattr(args, "members", 1) < 1:
@@ -789,7 +853,9 @@ def _run(args: argparse.Namespace) -> int:
         stand_ins += "n" if args.neighbours else ""
         kind = "searched_" if searched else f"contrast{args.contrast}{stand_ins}_" if args.contrast else ""
         cache = out / f"train_{kind}rollouts_{args.rollouts}_{args.seed}{workers}.npz"
-        if cache.exists():
+        if args.rollouts_from:
+            data = Rollouts.concat([Rollouts.load(path) for path in args.rollouts_from])
+        elif cache.exists():
             data = Rollouts.load(cache)
         elif contrast is not None:
             data = Rollouts.concat(collect_parallel(
@@ -804,12 +870,15 @@ def _run(args: argparse.Namespace) -> int:
         else:
             data = Rollouts.concat(collect_parallel(collect, (policy, args.skill), args.rollouts, args.seed,
                                                     args.workers, progress=not args.json, split="train"))
-        data.save(cache)
+        if not args.rollouts_from:
+            data.save(cache)
         views = FrameViews.of(data, policy, args.skill, search, progress=not args.json) if args.views else None
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
-                        views=views, encoder=args.encoder)
-        info.update(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
-                    policy=args.policy or "shipped")
+                        views=views, encoder=args.encoder, rank_weight=args.rank_weight)
+        info.update(skill=args.skill, rollouts=len(data) if args.rollouts_from else args.rollouts, seed=args.seed,
+                    workers=args.workers, policy=args.policy or "shipped")
+        if args.rollouts_from:
+            info.update(rollouts_from=args.rollouts_from)
         if searched:
             info.update(frames=args.frames, model=args.model or "shipped")
         if args.contrast:
@@ -823,7 +892,9 @@ def _run(args: argparse.Namespace) -> int:
                            + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
                            + (f" --model {args.model}" if searched and args.model else "")
                            + (f" --workers {args.workers}" if args.workers > 1 else "")
-                           + (f" --encoder {args.encoder}" if args.encoder != "cloud" else ""))
+                           + (f" --encoder {args.encoder}" if args.encoder != "cloud" else "")
+                           + (f" --rank-weight {args.rank_weight:g}" if args.rank_weight else "")
+                           + (" --rollouts-from " + " ".join(args.rollouts_from) if args.rollouts_from else ""))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
         return 0

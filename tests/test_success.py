@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import torch
 
+from affordplan.errors import InputError
 from primitives import success
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
@@ -149,7 +150,7 @@ def test_parallel_collection_splits_the_rollouts_and_worker_0_keeps_the_seed():
     alone = success.collect(policy, "push", 3, "train", n_objects=4, seed=3, progress=False)
     assert np.array_equal(alone.obs, parts[0].obs) and np.array_equal(alone.success, parts[0].success)
     assert not np.array_equal(parts[1].obs, alone.obs[:2])  # worker 1 draws other starts
-    with pytest.raises(success.InputError):
+    with pytest.raises(InputError):
         success.collect_parallel(success.collect, (policy, "push"), 5, seed=3, workers=0)
 
 
@@ -200,6 +201,80 @@ def test_frame_contrast_rollouts_execute_one_start_in_several_frames():
     again = success.collect_contrast(policy, "spin", 6, search, 3, "train", n_objects=3, seed=1, p_params=1.0,
                                      progress=False)
     assert np.array_equal(again.obs, data.obs) and np.array_equal(again.success, data.success)
+    assert success.contrast_starts(data.obs).tolist() == [0, 0, 0, 1, 1, 1]  # read back from the clouds alone
+
+
+def test_contrast_starts_are_runs_of_one_cloud_turned_or_mirrored():
+    """A cloud turned about the vertical or mirrored keeps its heights, so it is the same start; the next cloud, or
+    the same cloud again after another, starts a new one."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(0, 0.03, size=(2, 64, 9)).astype(np.float32)
+    R = Rotation.from_euler("z", 0.7).as_matrix()
+    mirror = np.diag([1.0, -1.0, 1.0])
+    turned = [np.concatenate([c[:, k:k + 3] @ M.T for k in (0, 3, 6)], axis=1) for c, M in ((a, R), (a, mirror))]
+    shuffled = a[rng.permutation(64)]  # the point order is not what makes a start
+    obs = np.stack([a, turned[0], turned[1], shuffled, b, b, a]).astype(np.float16)
+    assert success.contrast_starts(obs).tolist() == [0, 0, 0, 0, 1, 1, 2]
+    assert success.contrast_starts(obs[:0]).tolist() == []
+
+
+def test_pairwise_rank_loss_counts_the_pairs_within_a_start():
+    """``softplus(z_fail - z_success)`` over one start's pairs, averaged; pairs across starts or of equal labels do
+    not count, and its gradient raises the successful rollout's logit."""
+    logit = torch.tensor([2.0, 0.0, -1.0, 5.0, 3.0], requires_grad=True)
+    label = torch.tensor([1.0, 0.0, 0.0, 1.0, 1.0])
+    start = torch.tensor([0, 0, 0, 1, 1])
+    loss = success.pairwise_rank_loss(logit, label, start)
+    expected = (torch.nn.functional.softplus(torch.tensor(-2.0)) + torch.nn.functional.softplus(torch.tensor(-3.0))) / 2
+    assert loss.item() == pytest.approx(expected.item())
+    loss.backward()
+    assert logit.grad[0] < 0 < logit.grad[1] and logit.grad[3] == logit.grad[4] == 0
+    assert success.pairwise_rank_loss(logit, label, torch.arange(5)).item() == 0.0  # no start with two labels
+
+
+def _contrast_synthetic(n_starts: int, rng: np.random.Generator) -> success.Rollouts:
+    """Starts of 12 rollouts each, one cloud turned about the vertical; a start-level feature (the cloud's mean
+    height) sets whether a start is hard (10 % succeed) or easy (90 %), and within a start the rollouts whose goal
+    flow points to +x succeed more often (+30 points)."""
+    from scipy.spatial.transform import Rotation
+
+    obs, y, group = [], [], []
+    for s in range(n_starts):
+        cloud = rng.normal(0, 0.03, size=(32, 9)).astype(np.float32)
+        easy = rng.random() < 0.5
+        cloud[:, 2] += 0.03 if easy else -0.03
+        cloud[:, 6:9] = [0.05, 0.0, 0.0]
+        for turn in rng.uniform(-np.pi, np.pi, size=12):
+            R = Rotation.from_euler("z", turn).as_matrix()
+            turned = np.concatenate([cloud[:, k:k + 3] @ R.T for k in (0, 3, 6)], axis=1)
+            p = (0.75 if easy else 0.05) + (0.2 if np.cos(turn) > 0 else 0.0)
+            obs.append(turned), y.append(rng.random() < p), group.append(s % 40)
+    n = len(y)
+    return success.Rollouts(np.stack(obs).astype(np.float16), np.zeros((n, success.N_DECISION), np.float32),
+                            np.array(y), np.array(group), np.ones(n, bool))
+
+
+def test_a_ranking_loss_orders_one_starts_rollouts_and_keeps_the_calibration():
+    """``fit(rank_weight=...)`` on frame-contrast rollouts ranks one start's rollouts by what decides among them
+    (the goal flow's direction) and, Platt-scaled, stays calibrated across starts."""
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(4)
+    net, info = success.fit(_contrast_synthetic(150, rng), seed=0, epochs=8, progress=False, rank_weight=1.0)
+    assert info["rank_weight"] == 1.0
+    test = _contrast_synthetic(60, rng)
+    with torch.no_grad():
+        p = net(torch.from_numpy(test.obs.astype(np.float32)), torch.from_numpy(test.decision)).numpy()
+    towards_x = test.obs[:, 0, 6].astype(np.float32) > 0
+    start = success.contrast_starts(test.obs)
+    within = [success.auroc(p[start == s], towards_x[start == s]) for s in np.unique(start)
+              if 0 < towards_x[start == s].sum() < 12]
+    assert np.mean(within) > 0.9  # the order within a start follows the flow
+    m = success.metrics(p, test.success)
+    assert m["auroc"] > 0.8 and m["ece"] < 0.1
+    with pytest.raises(InputError):
+        success.fit(_contrast_synthetic(2, rng), epochs=1, progress=False, rank_weight=float("nan"))
 
 
 def test_smoothed_labels_share_the_outcomes_of_a_decision_and_its_neighbours(tmp_path):
@@ -288,6 +363,21 @@ def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
     info = torch.load(tmp_path / "success.pt", weights_only=False)["info"]
     assert info["encoder"] == "contact" and info["command"].endswith("--encoder contact")
     assert success.load_success_net("spin", tmp_path / "success.pt").encoder == "contact"
+    # The cached rollouts again, fitted with the ranking loss and read through --rollouts-from (twice, concatenated).
+    cache = str(tmp_path / "train_contrast3_rollouts_30_1.npz")
+    out = tmp_path / "ranked"
+    rc = success.main(["train", "spin", "--rollouts-from", cache, cache, "--rank-weight", "0.5", "--epochs", "1",
+                       "--seed", "1", "--out", str(out), "--json"])
+    assert rc == 0
+    info = torch.load(out / "success.pt", weights_only=False)["info"]
+    assert info["rank_weight"] == 0.5 and info["rollouts"] == 60 == info["train"] + info["calibration"]
+    assert info["rollouts_from"] == [cache, cache] and info["command"].endswith(f"--rollouts-from {cache} {cache}")
+    assert list(out.glob("*.npz")) == []  # nothing collected, nothing cached
+    for bad in (["--rank-weight", "1"], ["--contrast", "3", "--rank-weight", "-1"],
+                ["--rollouts-from", str(tmp_path / "missing.npz")]):
+        with pytest.raises(SystemExit):
+            success.main(["train", "spin", *bad, "--out", str(tmp_path / "no")])
+    assert not (tmp_path / "no").exists()
 
 
 def test_frame_contrast_rollouts_may_act_as_the_stand_in_requests():
@@ -419,5 +509,5 @@ def test_a_contact_encoder_learns_round_trips_and_answers_as_its_stacked_form(tm
     from primitives.ensemble import StackedEnsemble
 
     assert np.allclose(StackedEnsemble(again)(obs, dec).numpy(), p, atol=1e-6)
-    with pytest.raises(success.InputError):
+    with pytest.raises(InputError):
         success.SuccessNet(encoder="voxels")
