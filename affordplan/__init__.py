@@ -37,7 +37,7 @@ def plan(obj, goal, *, start=None, obstacles=(), time_limit=5.0, planner="afford
     return _plan(obj, goal, start=start, obstacles=obstacles, time_limit=time_limit, planner=planner, seed=seed,
                  **kwargs)
 
-__version__ = "0.22.0"
+__version__ = "0.23.0"
 
 
 def versions() -> dict[str, str]:
@@ -57,7 +57,7 @@ def versions() -> dict[str, str]:
 
 
 def versions_text(skip: tuple[str, ...] = ()) -> str:
-    """:func:`versions` as one line, ``"affordplan 0.22.0, mujoco 4.0.0, ..."``, less the names in ``skip``."""
+    """:func:`versions` as one line, ``"affordplan 0.23.0, mujoco 4.0.0, ..."``, less the names in ``skip``."""
     return ", ".join(f"{name} {v}" for name, v in versions().items() if name not in skip)
 
 
