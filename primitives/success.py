@@ -783,8 +783,8 @@ def build_parser() -> argparse.ArgumentParser:
                                            "--rollouts-from (default: 0, cross-entropy alone)")
     sub.choices["train"].add_argument("--rollouts-from", nargs="+", default=None, metavar="NPZ",
                                       help="fit on these saved rollouts (the train_*.npz files earlier train runs "
-                                           "wrote), concatenated, instead of collecting; --rollouts, --seed and "
-                                           "--workers then only name the run, and --seed still seeds the fit")
+                                           "wrote), concatenated, instead of collecting; --rollouts and --workers "
+                                           "are then not used, and --seed seeds the fit")
     sub.choices["train"].add_argument("--model", default=None,
                                       help="with --frames: the success model that picks the frames (default: shipped)")
     sub.choices["evaluate"].add_argument("--plot", default=None, help="reliability diagram PNG")
@@ -884,8 +884,9 @@ def _run(args: argparse.Namespace) -> int:
         if args.contrast:
             info.update(contrast=args.contrast, contrast_stand_ins=args.contrast_stand_ins, neighbours=args.neighbours)
         info["command"] = ("python -m primitives.success train " + args.skill
-                           + (f" --policy {args.policy}" if args.policy else "") + f" --rollouts {args.rollouts} "
-                           f"--seed {args.seed} --epochs {args.epochs} --members {args.members}"
+                           + (f" --policy {args.policy}" if args.policy else "")
+                           + ("" if args.rollouts_from else f" --rollouts {args.rollouts}")
+                           + f" --seed {args.seed} --epochs {args.epochs} --members {args.members}"
                            + (f" --contrast {args.contrast}" if args.contrast else "")
                            + (f" --contrast-stand-ins {args.contrast_stand_ins}" if args.contrast_stand_ins else "")
                            + (" --neighbours" if args.neighbours else "")

@@ -372,6 +372,7 @@ def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
     info = torch.load(out / "success.pt", weights_only=False)["info"]
     assert info["rank_weight"] == 0.5 and info["rollouts"] == 60 == info["train"] + info["calibration"]
     assert info["rollouts_from"] == [cache, cache] and info["command"].endswith(f"--rollouts-from {cache} {cache}")
+    assert "--rollouts " not in info["command"]  # the files, not a count, say what was fitted
     assert list(out.glob("*.npz")) == []  # nothing collected, nothing cached
     for bad in (["--rank-weight", "1"], ["--contrast", "3", "--rank-weight", "-1"],
                 ["--rollouts-from", str(tmp_path / "missing.npz")]):
