@@ -209,11 +209,11 @@ def test_contrast_starts_are_runs_of_one_cloud_turned_or_mirrored():
     the same cloud again after another, starts a new one."""
     from scipy.spatial.transform import Rotation
 
+    from primitives.frames import reframe_obs
+
     rng = np.random.default_rng(0)
     a, b = rng.normal(0, 0.03, size=(2, 64, 9)).astype(np.float32)
-    R = Rotation.from_euler("z", 0.7).as_matrix()
-    mirror = np.diag([1.0, -1.0, 1.0])
-    turned = [np.concatenate([c[:, k:k + 3] @ M.T for k in (0, 3, 6)], axis=1) for c, M in ((a, R), (a, mirror))]
+    turned = reframe_obs(a, np.stack([Rotation.from_euler("z", 0.7).as_matrix(), np.diag([1.0, -1.0, 1.0])]))
     shuffled = a[rng.permutation(64)]  # the point order is not what makes a start
     obs = np.stack([a, turned[0], turned[1], shuffled, b, b, a]).astype(np.float16)
     assert success.contrast_starts(obs).tolist() == [0, 0, 0, 0, 1, 1, 2]
@@ -240,17 +240,19 @@ def _contrast_synthetic(n_starts: int, rng: np.random.Generator) -> success.Roll
     flow points to +x succeed more often (+30 points)."""
     from scipy.spatial.transform import Rotation
 
+    from primitives.frames import reframe_obs
+
     obs, y, group = [], [], []
     for s in range(n_starts):
         cloud = rng.normal(0, 0.03, size=(32, 9)).astype(np.float32)
         easy = rng.random() < 0.5
         cloud[:, 2] += 0.03 if easy else -0.03
         cloud[:, 6:9] = [0.05, 0.0, 0.0]
-        for turn in rng.uniform(-np.pi, np.pi, size=12):
-            R = Rotation.from_euler("z", turn).as_matrix()
-            turned = np.concatenate([cloud[:, k:k + 3] @ R.T for k in (0, 3, 6)], axis=1)
+        turns = rng.uniform(-np.pi, np.pi, size=12)
+        obs.extend(reframe_obs(cloud, Rotation.from_euler("z", turns[:, None]).as_matrix()))
+        for turn in turns:
             p = (0.75 if easy else 0.05) + (0.2 if np.cos(turn) > 0 else 0.0)
-            obs.append(turned), y.append(rng.random() < p), group.append(s % 40)
+            y.append(rng.random() < p), group.append(s % 40)
     n = len(y)
     return success.Rollouts(np.stack(obs).astype(np.float16), np.zeros((n, success.N_DECISION), np.float32),
                             np.array(y), np.array(group), np.ones(n, bool))
