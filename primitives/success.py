@@ -44,6 +44,7 @@ import json
 import os
 import sys
 import time
+import zipfile
 import zlib
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
@@ -248,9 +249,13 @@ class Rollouts:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Rollouts:
-        z = np.load(path)
-        return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"],
-                   z["target"] if "target" in z.files else None)
+        """Rollouts saved by :meth:`save`; a file that is not one raises :class:`InputError`."""
+        try:
+            z = np.load(path)
+            return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"],
+                       z["target"] if "target" in z.files else None)
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile, AttributeError) as exc:
+            raise InputError(f"{path} is not a rollouts file saved by success train ({exc})") from exc
 
     @classmethod
     def concat(cls, parts: list[Rollouts]) -> Rollouts:

@@ -343,7 +343,7 @@ def test_frame_contrast_rollouts_restore_the_start_before_each_frame():
     assert data.success.any()  # a spin that succeeded moved the object: the second try started over
 
 
-def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
+def test_train_command_fits_on_frame_contrast_rollouts(tmp_path, capsys):
     """``success train SKILL --contrast K``: the rollouts are frame-contrast ones (cached under their own name), and
     the model file records how it was made; ``--contrast`` with ``--frames`` or below 0 is refused."""
     rc = success.main(["train", "spin", "--contrast", "3", "--rollouts", "30", "--epochs", "1", "--seed", "1",
@@ -381,6 +381,13 @@ def test_train_command_fits_on_frame_contrast_rollouts(tmp_path):
         with pytest.raises(SystemExit):
             success.main(["train", "spin", *bad, "--out", str(tmp_path / "no")])
     assert not (tmp_path / "no").exists()
+    broken = tmp_path / "broken.npz"
+    broken.write_bytes(b"not a zip")
+    assert success.main(["train", "spin", "--rollouts-from", str(broken), "--out", str(tmp_path / "b"), "--json"]) == 2
+    assert "broken.npz is not a rollouts file" in capsys.readouterr().err
+    np.savez(broken, obs=np.zeros(3))  # a real archive without the columns
+    with pytest.raises(InputError, match="not a rollouts file"):
+        success.Rollouts.load(broken)
 
 
 def test_frame_contrast_rollouts_may_act_as_the_stand_in_requests():
