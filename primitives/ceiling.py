@@ -27,7 +27,10 @@ states and poses for the same ``--seed``), the simulator is restored to the star
 
 A start counts when any candidate meets the criterion. This is a bound from below on what a policy
 could reach with this fingertip and protocol (a cleverer candidate may exist), and the shipped policy's
-greedy success on the same starts is printed beside it.
+greedy success on the same starts is printed beside it. It is a bound in hindsight: each start keeps whichever
+candidate worked. So the report also gives each **rule** on its own (a candidate's aim, height band, rank from the
+line, stroke and press, the same on every start): the best single rule is what the same privileged pusher reaches
+when it has to commit to one push before seeing the outcome.
 """
 
 from __future__ import annotations
@@ -59,27 +62,31 @@ class Candidate:
     contact: np.ndarray  # (3,) world, metres
     normal: np.ndarray  # (3,) world, outward unit normal
     motion: np.ndarray  # (3,) world, in [-1, 1] (x 3 cm per control step)
+    rule: str = ""  # what picked it, the same on every start: aim, height band, rank from the line, stroke, press
 
 
 def push_candidates(points: np.ndarray, normals: np.ndarray, com: np.ndarray, direction: float,
-                    per_band: int, strokes: tuple[float, ...], presses: tuple[float, ...]) -> list[Candidate]:
+                    per_band: int, strokes: tuple[float, ...], presses: tuple[float, ...],
+                    rule: str = "") -> list[Candidate]:
     """Scripted pushes along the world yaw ``direction`` (radians) of an object whose centre of mass is ``com``.
 
     ``points``, ``normals``: a dense world-frame cloud. In each height band, the ``per_band`` facing points
     nearest the line through ``com`` along the push, each with every stroke (fraction of the full stroke)
-    and press (downward motion component).
+    and press (downward motion component). Each candidate's ``rule`` is ``rule`` (what chose the direction)
+    followed by its band, rank from the line, stroke and press.
     """
     d = np.array([math.cos(direction), math.sin(direction), 0.0])
     facing, lateral = facing_and_offset(points, normals, com, d)  # lateral: from the push line through the COM
     z0, z1 = points[:, 2].min(), points[:, 2].max()
     out = []
-    for lo, hi in HEIGHT_BANDS:
+    for band_index, (lo, hi) in enumerate(HEIGHT_BANDS):
         band = facing & (points[:, 2] >= z0 + lo * (z1 - z0)) & (points[:, 2] <= z0 + hi * (z1 - z0))
         idx = np.flatnonzero(band)
-        for i in idx[np.argsort(lateral[idx])[:per_band]]:
+        for rank, i in enumerate(idx[np.argsort(lateral[idx])[:per_band]]):
             for s in strokes:
                 for press in presses:
-                    out.append(Candidate(points[i], normals[i], s * d + np.array([0.0, 0.0, -press])))
+                    label = f"{rule}band {band_index}, rank {rank}, stroke {s:g}, press {press:g}"
+                    out.append(Candidate(points[i], normals[i], s * d + np.array([0.0, 0.0, -press]), label))
     return out
 
 
@@ -93,11 +100,13 @@ def candidates_for(sim: Simulator, params: dict | None, rng: np.random.Generator
     com = sim.object_pose()[:3, 3]  # the object's body frame sits at its centre of mass
     if params is not None:
         turns = (0.0,) + tuple(sign * a for a in aims for sign in (1.0, -1.0))
-        return [c for turn in turns for c in push_candidates(points, normals, com, params["direction"] + turn, 2,
-                                                             (0.6, 0.7, 0.85, 1.0), (0.0, 0.5))]
+        return [c for turn in turns
+                for c in push_candidates(points, normals, com, params["direction"] + turn, 2, (0.6, 0.7, 0.85, 1.0),
+                                         (0.0, 0.5), f"aim {math.degrees(turn):+.4g} deg, ")]
     offset = rng.uniform(0.0, math.pi / 4)
     return [c for k in range(8)
-            for c in push_candidates(points, normals, com, offset + k * math.pi / 4, 1, (0.7, 1.0), (0.0,))]
+            for c in push_candidates(points, normals, com, offset + k * math.pi / 4, 1, (0.7, 1.0), (0.0,),
+                                     f"direction {45 * k} deg + a random offset, ")]
 
 
 @dataclass
@@ -108,6 +117,7 @@ class CeilingResult:
     any_success: int = 0  # starts where some candidate succeeded
     policy_success: int = 0  # starts where the shipped policy's greedy push succeeded
     candidate_success: list[float] = field(default_factory=list)  # per start, share of candidates that succeeded
+    rule_success: dict = field(default_factory=dict)  # candidate rule -> starts where that rule's push succeeded
     per_kind: dict = field(default_factory=dict)  # object kind -> [starts, any_success, policy_success]
 
     @property
@@ -118,20 +128,31 @@ class CeilingResult:
     def policy(self) -> float:
         return self.policy_success / max(1, self.starts)
 
+    def rules_ranked(self) -> list[tuple[str, float]]:
+        """Each rule's success over all the starts (a start where the rule found no contact counts as a
+        failure), best first; ties in the order the rules were first tried."""
+        return sorted(((r, n / max(1, self.starts)) for r, n in self.rule_success.items()), key=lambda t: -t[1])
+
     def as_dict(self) -> dict:
         d = asdict(self)
+        ranked = self.rules_ranked()
         d.update(ceiling=self.ceiling, policy=self.policy,
-                 mean_candidate_success=float(np.mean(self.candidate_success)) if self.candidate_success else 0.0)
+                 mean_candidate_success=float(np.mean(self.candidate_success)) if self.candidate_success else 0.0,
+                 best_rule=ranked[0][0] if ranked else None, best_rule_success=ranked[0][1] if ranked else 0.0,
+                 rule_success=dict(ranked))
         del d["candidate_success"]
         return d
 
     def report(self) -> str:
         aims = f", also aimed {', '.join(f'+-{a:g}' for a in self.aims_deg)} deg" if self.aims_deg else ""
+        share = self.as_dict()["mean_candidate_success"]
         lines = [f"push ({self.params}): {self.starts} held-out starts{aims}",
                  f"  best of scripted pushes (privileged COM, dense cloud): {self.ceiling:.3f}",
                  f"  shipped policy, greedy, same starts:                   {self.policy:.3f}",
-                 f"  share of scripted pushes that succeed, mean over starts: {np.mean(self.candidate_success):.3f}",
-                 "  per object kind (starts: ceiling / policy):"]
+                 f"  share of scripted pushes that succeed, mean over starts: {share:.3f}",
+                 "  the best single rules, each the same push on every start:"]
+        lines += [f"    {rate:.3f}  {rule}" for rule, rate in self.rules_ranked()[:3]]
+        lines.append("  per object kind (starts: ceiling / policy):")
         for kind, (n, a, p) in sorted(self.per_kind.items()):
             lines.append(f"    {kind:10s} {n:4d}: {a / n:.2f} / {p / n:.2f}")
         return "\n".join(lines)
@@ -157,7 +178,9 @@ def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, we
         cands = candidates_for(sim, prm, rng, aims)  # aims apply to a direction only
         for c in cands:
             sim.restore(start)
-            wins += judged_execution(sim, "push", prm, c.contact, c.motion, c.normal)
+            ok = judged_execution(sim, "push", prm, c.contact, c.motion, c.normal)
+            wins += ok
+            result.rule_success[c.rule] = result.rule_success.get(c.rule, 0) + ok
         sim.restore(start)
         idx, motion, _ = greedy_action(model, obs)
         policy_ok = env.step(idx, motion).success

@@ -50,6 +50,29 @@ def test_aimed_candidates_push_along_the_turned_direction(cube):
             ceiling.push_ceiling(starts=1, aims=(bad,), progress=False)
 
 
+def test_each_candidate_names_its_rule_once_per_start(cube):
+    """A rule (aim, band, rank, stroke, press) picks at most one push per start, so each rule's tally over the
+    starts is that rule's own success; the labels carry the aim."""
+    sim = ap.Simulator(cube, seed=0)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.3)
+    aimed = candidates_for(sim, {"direction": 0.4}, np.random.default_rng(0), aims=(math.radians(5.0),))
+    rules = [c.rule for c in aimed]
+    assert len(set(rules)) == len(rules)
+    assert {r.split(",")[0] for r in rules} == {"aim +0 deg", "aim +5 deg", "aim -5 deg"}
+    seed_objective = candidates_for(sim, None, np.random.default_rng(0))
+    assert len({c.rule for c in seed_objective}) == len(seed_objective)
+
+
+def test_rules_are_ranked_by_their_success_over_all_starts():
+    result = ceiling.CeilingResult(starts=4, params="random", any_success=3,
+                                   rule_success={"a": 1, "b": 3, "c": 2})
+    assert result.rules_ranked() == [("b", 0.75), ("c", 0.5), ("a", 0.25)]
+    d = result.as_dict()
+    assert d["best_rule"] == "b" and d["best_rule_success"] == 0.75 and d["ceiling"] == 0.75
+    assert list(d["rule_success"]) == ["b", "c", "a"]
+    assert "0.750  b" in result.report()
+
+
 def test_a_centre_line_push_moves_the_cube_straight(cube):
     sim = ap.Simulator(cube, seed=0)
     sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
