@@ -128,6 +128,11 @@ class CeilingResult:
     def policy(self) -> float:
         return self.policy_success / max(1, self.starts)
 
+    @property
+    def mean_candidate_success(self) -> float:
+        """The share of scripted pushes that succeed, mean over the starts: a push drawn at random."""
+        return float(np.mean(self.candidate_success)) if self.candidate_success else 0.0
+
     def rules_ranked(self) -> list[tuple[str, float]]:
         """Each rule's success over all the starts (a start where the rule found no contact counts as a
         failure), best first; ties in the order the rules were first tried."""
@@ -137,7 +142,7 @@ class CeilingResult:
         d = asdict(self)
         ranked = self.rules_ranked()
         d.update(ceiling=self.ceiling, policy=self.policy,
-                 mean_candidate_success=float(np.mean(self.candidate_success)) if self.candidate_success else 0.0,
+                 mean_candidate_success=self.mean_candidate_success,
                  best_rule=ranked[0][0] if ranked else None, best_rule_success=ranked[0][1] if ranked else 0.0,
                  rule_success=dict(ranked))
         del d["candidate_success"]
@@ -145,11 +150,10 @@ class CeilingResult:
 
     def report(self) -> str:
         aims = f", also aimed {', '.join(f'+-{a:g}' for a in self.aims_deg)} deg" if self.aims_deg else ""
-        share = self.as_dict()["mean_candidate_success"]
         lines = [f"push ({self.params}): {self.starts} held-out starts{aims}",
                  f"  best of scripted pushes (privileged COM, dense cloud): {self.ceiling:.3f}",
                  f"  shipped policy, greedy, same starts:                   {self.policy:.3f}",
-                 f"  share of scripted pushes that succeed, mean over starts: {share:.3f}",
+                 f"  share of scripted pushes that succeed, mean over starts: {self.mean_candidate_success:.3f}",
                  "  the best single rules, each the same push on every start:"]
         lines += [f"    {rate:.3f}  {rule}" for rule, rate in self.rules_ranked()[:3]]
         lines.append("  per object kind (starts: ceiling / policy):")

@@ -64,13 +64,14 @@ def test_each_candidate_names_its_rule_once_per_start(cube):
 
 
 def test_rules_are_ranked_by_their_success_over_all_starts():
-    result = ceiling.CeilingResult(starts=4, params="random", any_success=3,
+    result = ceiling.CeilingResult(starts=4, params="random", any_success=3, candidate_success=[0.5, 0.25, 0.0, 0.75],
                                    rule_success={"a": 1, "b": 3, "c": 2})
     assert result.rules_ranked() == [("b", 0.75), ("c", 0.5), ("a", 0.25)]
     d = result.as_dict()
     assert d["best_rule"] == "b" and d["best_rule_success"] == 0.75 and d["ceiling"] == 0.75
-    assert list(d["rule_success"]) == ["b", "c", "a"]
-    assert "0.750  b" in result.report()
+    assert list(d["rule_success"]) == ["b", "c", "a"] and d["mean_candidate_success"] == 0.375
+    assert "0.750  b" in result.report() and "mean over starts: 0.375" in result.report()
+    assert ceiling.CeilingResult(starts=1, params="random").mean_candidate_success == 0.0
 
 
 def test_a_centre_line_push_moves_the_cube_straight(cube):
