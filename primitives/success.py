@@ -46,7 +46,7 @@ import sys
 import time
 import zipfile
 import zlib
-from dataclasses import dataclass, fields, replace
+from dataclasses import MISSING, dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -250,12 +250,23 @@ class Rollouts:
     @classmethod
     def load(cls, path: str | os.PathLike) -> Rollouts:
         """Rollouts saved by :meth:`save`; a file that is not one raises :class:`InputError`."""
+        def refused(why: object) -> InputError:
+            return InputError(f"{path} is not a rollouts file saved by success train ({why})")
+
         try:
-            z = np.load(path)
-            return cls(z["obs"], z["decision"], z["success"], z["group"], z["parameterised"],
-                       z["target"] if "target" in z.files else None)
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile, AttributeError) as exc:
-            raise InputError(f"{path} is not a rollouts file saved by success train ({exc})") from exc
+            archive = np.load(path)
+        except (OSError, ValueError, zipfile.BadZipFile) as exc:  # unreadable, not numpy's, or pickled objects
+            raise refused(exc) from exc
+        if not isinstance(archive, np.lib.npyio.NpzFile):
+            raise refused("a single array, not an archive of columns")
+        with archive:
+            missing = [f.name for f in fields(cls) if f.default is MISSING and f.name not in archive.files]
+            if missing:
+                raise refused(f"no {', '.join(missing)}")
+            try:
+                return cls(*(archive[f.name] if f.name in archive.files else None for f in fields(cls)))
+            except (OSError, ValueError, zipfile.BadZipFile, zlib.error) as exc:  # a damaged column
+                raise refused(exc) from exc
 
     @classmethod
     def concat(cls, parts: list[Rollouts]) -> Rollouts:

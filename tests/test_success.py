@@ -386,8 +386,12 @@ def test_train_command_fits_on_frame_contrast_rollouts(tmp_path, capsys):
     assert success.main(["train", "spin", "--rollouts-from", str(broken), "--out", str(tmp_path / "b"), "--json"]) == 2
     assert "broken.npz is not a rollouts file" in capsys.readouterr().err
     np.savez(broken, obs=np.zeros(3))  # a real archive without the columns
-    with pytest.raises(InputError, match="not a rollouts file"):
+    with pytest.raises(InputError, match="not a rollouts file .*no decision, success, group, parameterised"):
         success.Rollouts.load(broken)
+    single = tmp_path / "single.npy"
+    np.save(single, np.zeros(3))  # numpy's, but one array
+    with pytest.raises(InputError, match="single.npy is not a rollouts file"):
+        success.Rollouts.load(single)
 
 
 def test_frame_contrast_rollouts_may_act_as_the_stand_in_requests():
