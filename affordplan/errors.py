@@ -29,3 +29,12 @@ class PlanningError(AffordplanError):
 
 class ReachabilityError(AffordplanError):
     """The pusher cannot reach the requested contact."""
+
+
+class WeightsError(AffordplanError):
+    """A weights or checkpoint file is missing, damaged, unsafe (it would run code to load), or made for another
+    skill, kind of model or sensor; the message names which."""
+
+
+class PerceptionError(AffordplanError):
+    """The sensor cannot see the object (hidden behind obstacles or the arm from every camera)."""

@@ -41,6 +41,8 @@ TOP_LEVEL = ("name", "description", "object", "size", "start", "goal", "obstacle
 START_FIELDS = ("resting_state", "xy", "yaw", "yaw_deg")
 GOAL_FIELDS = ("xy", "yaw", "yaw_deg", "resting_state", "xy_tol", "yaw_tol", "yaw_tol_deg", "yaw_symmetric")
 BOX_FIELDS = ("center", "size", "yaw", "yaw_deg")
+MAX_FILE_BYTES = 1_000_000  # a scene is a few hundred bytes; this bounds reading and parsing
+MAX_DEPTH = 8  # nesting of mappings and lists; a scene needs 3
 
 # The README's main job: the mug lies on its side behind a wall with a 22 cm gap; the plan flips it
 # upright (resting state 1, opening up), pushes it through the gap and turns it to 90 deg.
@@ -118,27 +120,74 @@ def demo_scene() -> Scene:
 def load_scene(path: str | os.PathLike) -> Scene:
     """Read a scene from a ``.json``, ``.yaml`` or ``.yml`` file (YAML needs PyYAML)."""
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"scene file {_short(str(path))} is a folder; give a .json or .yaml file")
     if not path.is_file():
-        raise InputError(f"scene file {str(path)!r} does not exist")
-    text = path.read_text(encoding="utf-8")
+        raise InputError(f"scene file {_short(str(path))} does not exist")
     suffix = path.suffix.lower()
-    if suffix in (".yaml", ".yml"):
-        try:
-            import yaml
-        except ImportError as exc:  # pragma: no cover - pyyaml is a dependency
-            raise InputError(f"{path}: reading YAML needs PyYAML (pip install pyyaml), or use JSON") from exc
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            raise InputError(f"{path}: not valid YAML: {exc}") from exc
-    elif suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(f"{path}: not valid JSON: {exc}") from exc
-    else:
+    if suffix not in (".json", ".yaml", ".yml"):
         raise InputError(f"{path}: a scene file must end in .json, .yaml or .yml")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise InputError(f"{path}: a scene file is at most {MAX_FILE_BYTES // 1000} kB; this one is "
+                         f"{path.stat().st_size // 1000} kB")
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not UTF-8 text (byte {exc.start}); save the scene file as UTF-8") from None
+    data = _parse_yaml(text, path) if suffix in (".yaml", ".yml") else _parse_json(text, path)
     return parse_scene(data, source=str(path), base_dir=path.parent, default_name=path.stem)
+
+
+def _check_structure(text: str, path: Path) -> None:
+    """Refuse YAML that could expand beyond what it shows: aliases (``*a``, each one a copy of a whole anchored
+    value: nine nested levels of them make gigabytes from 400 bytes) and nesting deeper than ``MAX_DEPTH``."""
+    import yaml
+
+    depth = 0
+    try:
+        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+            if isinstance(event, yaml.AliasEvent):
+                raise InputError(f"{path}: YAML aliases (*{_short(event.anchor, 20)}) are not allowed in scene files; "
+                                 "write the values out")
+            if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+                depth += 1
+                if depth > MAX_DEPTH:
+                    raise InputError(f"{path}: nested deeper than {MAX_DEPTH} levels; a scene is at most {MAX_DEPTH}")
+            elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+                depth -= 1
+    except yaml.YAMLError as exc:
+        raise InputError(f"{path}: not valid YAML: {str(exc)[:300]}") from None
+
+
+def _parse_yaml(text: str, path: Path) -> Any:
+    import yaml
+
+    _check_structure(text, path)
+    try:
+        return yaml.safe_load(text)
+    except (yaml.YAMLError, ValueError, OverflowError) as exc:
+        raise InputError(f"{path}: not valid YAML: {str(exc)[:300]}") from None
+
+
+def _parse_json(text: str, path: Path) -> Any:
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}: not valid JSON: {str(exc)[:300]}") from None
+    except (RecursionError, ValueError) as exc:  # deep nesting; a number of more than 4300 digits
+        raise InputError(f"{path}: JSON too deeply nested or with an over-long number ({type(exc).__name__})") \
+            from None
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    """A description of ``value`` of at most ``limit`` characters: never format an unbounded value into a message.
+    Containers are described by type and length, not expanded (a YAML alias bomb is gigabytes of repr)."""
+    if isinstance(value, (list, tuple, dict, set)):
+        return f"a {type(value).__name__} of {len(value)} items"
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**30:
+        return f"an integer of {len(str(abs(value)))} digits"
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def parse_scene(data: Any, source: str = "<scene>", base_dir: str | os.PathLike | None = None,
@@ -174,32 +223,38 @@ def _known(d: Mapping, allowed: tuple[str, ...], source: str, prefix: str) -> No
     unknown = sorted(str(k) for k in d if k not in allowed)
     if unknown:
         where = f"{prefix}: " if prefix else ""
-        raise InputError(f"{source}: {where}unknown field(s) {unknown}; expected some of {list(allowed)}")
+        raise InputError(f"{source}: {where}unknown field(s) {', '.join(unknown)[:200]}; expected some of "
+                         f"{list(allowed)}")
 
 
 def _text(value: Any, source: str, name: str) -> str:
     if not isinstance(value, str):
-        raise InputError(f"{source}: {name} must be a string, got {value!r}")
+        raise InputError(f"{source}: {name} must be a string, got {_short(value)}")
     return value
 
 
 def _number(value: Any, source: str, name: str, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"{source}: {name} must be a finite number, got {value!r}")
+    finite = not isinstance(value, bool) and isinstance(value, (int, float))
+    try:
+        finite = finite and math.isfinite(float(value))
+    except OverflowError:  # an integer beyond a float's range
+        finite = False
+    if not finite:
+        raise InputError(f"{source}: {name} must be a finite number, got {_short(value)}")
     if positive and value <= 0:
-        raise InputError(f"{source}: {name} must be positive, got {value!r}")
+        raise InputError(f"{source}: {name} must be positive, got {_short(value)}")
     return float(value)
 
 
 def _numbers(value: Any, n: int, source: str, name: str, unit: str) -> tuple[float, ...]:
     if not isinstance(value, (list, tuple)) or len(value) != n:
-        raise InputError(f"{source}: {name} must be a list of {n} numbers ({unit}), got {value!r}")
+        raise InputError(f"{source}: {name} must be a list of {n} numbers ({unit}), got {_short(value)}")
     return tuple(_number(v, source, f"{name}[{i}]") for i, v in enumerate(value))
 
 
 def _index(value: Any, source: str, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-        raise InputError(f"{source}: {name} must be a resting-state index (an integer >= 0), got {value!r}")
+        raise InputError(f"{source}: {name} must be a resting-state index (an integer >= 0), got {_short(value)}")
     return int(value)
 
 
@@ -216,7 +271,7 @@ def _angle(d: Mapping, key: str, source: str, prefix: str, default: float | None
 
 def _object_source(value: Any, source: str, base_dir) -> str:
     if not isinstance(value, str) or not value.strip():
-        raise InputError(f"{source}: object must be a catalogue name or a mesh path, got {value!r}")
+        raise InputError(f"{source}: object must be a catalogue name or a mesh path, got {_short(value)}")
     if base_dir is not None and Path(value).suffix.lower() in MESH_SUFFIXES and not Path(value).is_absolute():
         candidate = Path(base_dir) / value
         if candidate.exists():
@@ -254,7 +309,7 @@ def _goal(value: Any, source: str) -> Goal:
         kwargs["yaw_tol"] = _number(tol, source, "goal.yaw_tol", positive=True)
     if "yaw_symmetric" in d:
         if not isinstance(d["yaw_symmetric"], bool):
-            raise InputError(f"{source}: goal.yaw_symmetric must be true or false, got {d['yaw_symmetric']!r}")
+            raise InputError(f"{source}: goal.yaw_symmetric must be true or false, got {_short(d['yaw_symmetric'])}")
         kwargs["yaw_symmetric"] = d["yaw_symmetric"]
     try:
         return Goal(**kwargs)

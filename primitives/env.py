@@ -30,7 +30,9 @@ import numpy as np
 
 from affordplan.checks import require_probability, require_whole
 from affordplan.errors import InputError
+from affordplan.objects import housekeep
 from affordplan.objects.model import ObjectModel, load_object, random_object
+from affordplan.sim.sensor import SENSORS
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import params as skill_params
 from primitives import rewards
@@ -46,7 +48,10 @@ class EnvConfig:
     """What the environment draws from.
 
     ``objects``: ``"train"`` or ``"test"`` (the procedural splits, ``n_objects`` of them), ``"seed7"``
-    (the seed's seven), or a tuple of catalogue names / mesh paths.
+    (the seed's seven), ``"housekeep:SPLIT"`` (HACMan's household meshes of a split,
+    :func:`affordplan.objects.housekeep.names`), several of these joined by ``+`` (each episode draws a group
+    uniformly, then an object in it), or a tuple of catalogue names / mesh paths.
+    ``sensor``: how the policy sees the object (:meth:`affordplan.Simulator.point_cloud`).
     """
 
     primitive: str = "push"
@@ -61,6 +66,7 @@ class EnvConfig:
     model_cache: int = 512
     episodes_per_object: int = 8  # consecutive episodes on one drawn object: amortises its setup
     p_params: float = 0.0  # probability that an episode asks for a parameter (0: the seed's objective)
+    sensor: str = "cameras"
 
 
 @dataclass(frozen=True)
@@ -136,6 +142,8 @@ def check_env_config(config: EnvConfig) -> None:
     for name, low in least.items():
         require_whole(f"EnvConfig.{name}", getattr(config, name), low)
     require_probability("EnvConfig.p_params", config.p_params)
+    if config.sensor not in SENSORS:
+        raise InputError(f"unknown sensor {config.sensor!r}; expected one of {SENSORS}")
 
 
 def _lru(cache: OrderedDict, key, capacity: int, build: Callable[[], T], evict: Callable[[T], None] | None = None) -> T:
@@ -168,13 +176,22 @@ class PrimitiveEnv:
         self._episodes_left = 0
 
     # ------------------------------------------------------------------ objects
-    def _object_keys(self) -> list:
+    def _object_groups(self) -> list[list]:
+        """The object keys to draw from, in groups (an episode draws a group uniformly, then a key in it)."""
         c = self.config
-        if c.objects in ("train", "test"):
-            return [(c.objects, i) for i in range(c.n_objects)]
-        if c.objects == "seed7":
-            return list(SEED_SEVEN)
-        return list(c.objects)
+        if not isinstance(c.objects, str):
+            return [list(c.objects)]
+        groups = []
+        for spec in c.objects.split("+"):
+            if spec in ("train", "test"):
+                groups.append([(spec, i) for i in range(c.n_objects)])
+            elif spec == "seed7":
+                groups.append(list(SEED_SEVEN))
+            elif spec.startswith("housekeep:"):
+                groups.append([housekeep.PREFIX + name for name in housekeep.names(spec.split(":", 1)[1])])
+            else:
+                raise InputError(f"unknown object set {spec!r}: train, test, seed7 or housekeep:SPLIT")
+        return groups
 
     def _load(self, key) -> ObjectModel:
         """The model of object ``key``, from the model cache when it was built before."""
@@ -183,7 +200,8 @@ class PrimitiveEnv:
 
     def _simulator(self, key) -> Simulator:
         return _lru(self._sims, key, self.config.sim_cache,
-                    lambda: Simulator(self._load(key), seed=int(self.rng.integers(2**31))), evict=Simulator.close)
+                    lambda: Simulator(self._load(key), seed=int(self.rng.integers(2**31)),
+                                                                    sensor=self.config.sensor), evict=Simulator.close)
 
     # ---------------------------------------------------------------- episode
     def reset(self, object_key=None, resting_state: int | None = None, params="random") -> np.ndarray:
@@ -196,7 +214,8 @@ class PrimitiveEnv:
         elif self._episodes_left > 0 and self.object_key is not None:
             key = self.object_key
         else:
-            keys = self._object_keys()
+            groups = self._object_groups()
+            keys = groups[int(self.rng.integers(len(groups)))] if len(groups) > 1 else groups[0]
             key = keys[int(self.rng.integers(len(keys)))]
             self._episodes_left = self.config.episodes_per_object
         self._episodes_left -= 1

@@ -18,7 +18,6 @@ import json
 import os
 import sys
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -27,7 +26,8 @@ from tqdm import tqdm
 from affordplan.errors import AffordplanError
 from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
 from primitives.frames import FrameSearch
-from primitives.networks import HybridActorCritic, widen_input
+from primitives.networks import HybridActorCritic
+from primitives.policy import greedy_action, load_policy  # noqa: F401  (re-exported: older imports)
 
 # The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
 SEED_FIG5 = {
@@ -36,39 +36,6 @@ SEED_FIG5 = {
     "planter_2": (0.245, 0.79, 0.405),
 }
 SEED_FIG3 = {"push": 0.43, "roll": 0.75, "spin": 0.47}
-WEIGHTS_DIR = Path(__file__).parent / "weights"
-
-
-def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActorCritic:
-    """A policy from a ``policy.pt`` / ``checkpoint.pt`` file, or the shipped weights."""
-    from primitives import checkpoint as ckpt
-
-    path = Path(weights) if weights else WEIGHTS_DIR / f"{primitive}.pt"
-    if not path.exists():
-        raise ckpt.CheckpointError(f"no weights at {path}")
-    try:
-        state = torch.load(path, map_location="cpu", weights_only=False)
-    except Exception as exc:
-        raise ckpt.CheckpointError(f"weights {path} are damaged ({type(exc).__name__}: {exc})") from exc
-    if isinstance(state, dict) and "model" in state:
-        state = state["model"]
-    model = HybridActorCritic()
-    model.load_state_dict(widen_input(state))
-    model.eval()
-    return model
-
-
-def greedy_action(model: HybridActorCritic, obs: np.ndarray,
-                  allowed: np.ndarray | None = None) -> tuple[int, np.ndarray, np.ndarray]:
-    """Deterministic action: ``(contact index, motion, critic map)``.
-
-    ``allowed``: an optional boolean mask over the points; the contact is the best allowed one.
-    """
-    actions, q = model.maps(torch.from_numpy(obs)[None])
-    scores = q[0] if allowed is None else torch.where(torch.from_numpy(np.asarray(allowed, dtype=bool)), q[0],
-                                                      torch.tensor(-torch.inf))
-    idx = int(scores.argmax())
-    return idx, actions[0, idx].numpy().astype(np.float64), q[0].numpy()
 
 
 @dataclass

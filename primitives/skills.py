@@ -36,9 +36,9 @@ from affordplan.errors import InputError, ReachabilityError
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.env import PRIMITIVES, SkillObservation, skill_observation
-from primitives.evaluate import greedy_action, load_policy
 from primitives.frames import FrameSearch, reframe_obs
 from primitives.networks import HybridActorCritic
+from primitives.policy import greedy_action, load_policy
 from primitives.success import WEIGHTS_DIR, SuccessModel, load_success_net
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice

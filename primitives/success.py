@@ -55,14 +55,15 @@ import torch.nn.functional as F
 from torch import nn
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
+from affordplan.errors import AffordplanError, InputError, WeightsError
+from primitives import weights_file
 from primitives.ensemble import StackedEnsemble
 from primitives.env import OBS_DIM, PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
 from primitives.neighbours import neighbour_outcomes
 from primitives.networks import HybridActorCritic
 
-WEIGHTS_DIR = Path(__file__).parent / "weights"
+WEIGHTS_DIR = weights_file.SHIPPED_DIR  # kept for older imports
 N_DECISION = 14  # policy-decision features, see decision_features (files fitted before 0.20 use the first 13)
 CONTRAST_TURNS = 12  # turns about the vertical of frame-contrast rollouts, as the shipped frame searches try
 
@@ -684,24 +685,26 @@ def _platt(z: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
 
 
 # ------------------------------------------------------------------------ save and load
-def save(net: SuccessNet, path: str | os.PathLike, info: dict) -> None:
-    from primitives import checkpoint as ckpt
-
-    ckpt.save(Path(path), dict(model=net.state_dict(), info=info))
+def save(net: SuccessNet, path: str | os.PathLike, info: dict, sensor: str | None = None) -> None:
+    """Write a success net in the safe weights format (:mod:`primitives.weights_file`); ``info["skill"]`` names its
+    skill."""
+    meta = weights_file.make_meta(info["skill"], "success", sensor=sensor or info.get("sensor", "surface"))
+    weights_file.save(Path(path), dict(model=net.state_dict(), info=info), meta)
 
 
 def load_success_net(skill: str, path: str | os.PathLike | None = None) -> SuccessNet:
-    """A success net from ``path`` or the shipped ``weights/{skill}_success.pt``."""
-    from primitives import checkpoint as ckpt
+    """A success net from ``path`` or the shipped ``weights/{skill}_success.pt``.
 
+    Raises:
+        WeightsError: missing, damaged or unsafe file, or one for another skill or kind of model.
+    """
     path = Path(path) if path else WEIGHTS_DIR / f"{skill}_success.pt"
-    if not path.exists():
-        raise ckpt.CheckpointError(f"no success model at {path}")
+    payload, _ = weights_file.load(path, kind="success", skill=skill)
     try:
-        state = torch.load(path, map_location="cpu", weights_only=False)
-        net = SuccessNet.from_state_dict(state["model"])
-    except Exception as exc:
-        raise ckpt.CheckpointError(f"success model {path} is damaged ({type(exc).__name__}: {exc})") from exc
+        net = SuccessNet.from_state_dict(payload["model"])
+    except Exception as exc:  # a state dict of the right kind but the wrong shapes
+        raise WeightsError(f"success model {path} does not fit the network ({type(exc).__name__}: "
+                           f"{str(exc).splitlines()[0][:200] if str(exc) else ''})") from exc
     return net.eval()
 
 

@@ -50,7 +50,9 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import os
 import resource
+import signal
 import sys
 import time
 from collections import deque
@@ -65,6 +67,7 @@ from tqdm import tqdm
 from affordplan.checks import is_finite, require_probability, require_whole
 from affordplan.errors import InputError
 from primitives import checkpoint as ckpt
+from primitives import weights_file
 from primitives.env import PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.hindsight import relabel
 from primitives.networks import HybridActorCritic
@@ -85,7 +88,10 @@ class TrainConfig:
     out: str = "runs/push"
     max_minutes: float = 60.0
     n_points: int = 256  # object points per cloud (HACMan: 400); the maps are point-count agnostic
-    objects: str | tuple[str, ...] = "train"  # the procedural training split, or catalogue names
+    # What trains: the procedural training split and HACMan's household training meshes (never its unseen ones),
+    # each drawn half the time (primitives.env.EnvConfig.objects).
+    objects: str | tuple[str, ...] = "train+housekeep:training"
+    sensor: str = "cameras"  # how the policy sees the object (affordplan.Simulator.point_cloud)
     n_objects: int = 500
     p_params: float = 0.75  # share of episodes that ask for a parameter (0: the seed's objective only)
     init: str | None = None  # weights to start from (ignored on --resume)
@@ -113,7 +119,7 @@ class TrainConfig:
 
 def env_config(cfg: TrainConfig) -> EnvConfig:
     return EnvConfig(cfg.primitive, objects=cfg.objects, n_objects=cfg.n_objects, n_points=cfg.n_points,
-                     p_params=cfg.p_params, sim_cache=cfg.sim_cache)
+                     p_params=cfg.p_params, sim_cache=cfg.sim_cache, sensor=cfg.sensor)
 
 
 def exploration(cfg: TrainConfig) -> Exploration:
@@ -122,9 +128,55 @@ def exploration(cfg: TrainConfig) -> Exploration:
 
 
 # Settings the command line sets; the others are TrainConfig fields only.
-_CLI_SETTINGS = frozenset({"steps", "workers", "max_minutes", "checkpoint_minutes", "lr", "p_params", "p_scripted",
+_CLI_SETTINGS = frozenset({"objects", "sensor",
+                           "steps", "workers", "max_minutes", "checkpoint_minutes", "lr", "p_params", "p_scripted",
                            "batch_size", "replay_size", "learning_starts", "weight_sync_updates", "n_points",
                            "torch_threads", "replay_ratio", "precision"})
+
+
+# Settings a resumed run must share with its checkpoint: what it learns, what it sees, what its replay holds.
+RESUME_MUST_MATCH = ("primitive", "objects", "n_objects", "sensor", "n_points", "replay_size", "p_params")
+
+
+class RunLock:
+    """An exclusive lock on a run folder (``OUT/.lock``, ``fcntl.flock``), held while a run writes there; the
+    kernel drops it when the process dies, however it dies, so a killed run never leaves a stale lock."""
+
+    def __init__(self, out: Path):
+        import fcntl
+
+        self.path = out / ".lock"
+        self._file = open(self.path, "a+")
+        try:
+            fcntl.flock(self._file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self._file.seek(0)
+            holder = self._file.read().strip()[:20]
+            self._file.close()
+            raise InputError(f"another training run (pid {holder or '?'}) is writing to {out}; wait for it or give "
+                             "another --out") from None
+        self._file.seek(0)
+        self._file.truncate()
+        self._file.write(str(os.getpid()))
+        self._file.flush()
+
+    def release(self) -> None:
+        if not self._file.closed:
+            self._file.close()
+
+
+def check_resume(saved_config: dict, cfg: TrainConfig, path: Path) -> None:
+    """Raise :class:`InputError` naming every setting in ``RESUME_MUST_MATCH`` where the checkpoint's run differs."""
+    now = asdict(cfg)
+    differ = [f"{_setting(k)} {str(saved_config.get(k))[:60]} there, {str(now[k])[:60]} now"
+              for k in RESUME_MUST_MATCH if _normal(saved_config.get(k)) != _normal(now[k])]
+    if differ:
+        raise InputError(f"cannot resume {path}: it is a run with other settings ({'; '.join(differ)}); give "
+                         "another --out, or the same settings")
+
+
+def _normal(value):
+    return list(value) if isinstance(value, (list, tuple)) else value
 
 
 def _setting(name: str) -> str:
@@ -210,9 +262,28 @@ def update(model, opt_critic, opt_actor, batch, cfg: TrainConfig, n_updates: int
 
 
 def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict:
+    """Train ``cfg.primitive`` into ``cfg.out`` (see the module docstring); the run holds the folder's lock.
+
+    Raises:
+        InputError: bad settings; ``--resume`` into a missing folder or one holding a run with other settings;
+            another run holding the folder.
+        CheckpointError: a damaged or unsafe checkpoint.
+    """
     check_config(cfg)
     out = Path(cfg.out)
+    if resume and not out.is_dir():
+        raise InputError(f"--resume: no run folder {out} (mistyped?); without --resume a new run starts there")
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} is a file, not a folder")
     out.mkdir(parents=True, exist_ok=True)
+    lock = RunLock(out)
+    try:
+        return _train_locked(cfg, out, resume, progress)
+    finally:
+        lock.release()
+
+
+def _train_locked(cfg: TrainConfig, out: Path, resume: bool, progress: bool) -> dict:
     torch.set_num_threads(cfg.torch_threads)
     torch.manual_seed(cfg.seed)
     if cfg.precision == "bf16" and not bf16_is_fast():
@@ -220,7 +291,7 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
               "slower than with fp32", file=sys.stderr)
     model = HybridActorCritic()
     if cfg.init and not (resume and (out / "checkpoint.pt").exists()):
-        from primitives.evaluate import load_policy
+        from primitives.policy import load_policy
 
         model.load_state_dict(load_policy(cfg.init, cfg.primitive).state_dict())
     critic_params = [*model.backbone.parameters(), *model.q1.parameters(), *model.q2.parameters()]
@@ -232,9 +303,12 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
     state = dict(global_step=0, n_updates=0, invalid=0, elapsed=0.0, rss_samples=[])
     ckpt_path = out / "checkpoint.pt"
     if resume and not ckpt_path.exists():
-        print(f"no checkpoint in {out} to resume from: starting a new run there", file=sys.stderr)
+        print(f"no checkpoint in {out} yet (the run stopped before its first): starting it again from step 0",
+              file=sys.stderr)
+        resume = False
     elif resume:
-        saved = ckpt.load(ckpt_path)
+        saved = ckpt.load(ckpt_path, skill=cfg.primitive)
+        check_resume(saved.get("config", {}), cfg, ckpt_path)
         model.load_state_dict(saved["model"])
         opt_critic.load_state_dict(saved["opt_critic"])
         opt_actor.load_state_dict(saved["opt_actor"])
@@ -255,6 +329,8 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
 
     log_path = out / "log.csv"
     new_log = not log_path.exists() or not resume
+    if not new_log:  # rows a killed run logged after its last checkpoint are logged again from there: drop them
+        _truncate_log(log_path, state["global_step"])
     log_file = open(log_path, "w" if new_log else "a", newline="")
     log = csv.writer(log_file)
     if new_log:
@@ -283,6 +359,7 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
         recent_success.append(success)
         recent_reward.append(reward)
 
+    interrupted = False
     try:
         while state["global_step"] < cfg.steps and (time.time() - t_start) < 60 * cfg.max_minutes:
             # 1. Collect.
@@ -343,30 +420,57 @@ def train(cfg: TrainConfig, resume: bool = False, progress: bool = True) -> dict
                 state["elapsed"] = time.time() - t_start
                 _save(ckpt_path, model, opt_critic, opt_actor, replay, rng, gen, state, cfg)
                 t_ckpt = time.time()
+    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (main turns it into this): keep what was learned
+        interrupted = True
     finally:
-        if source is not None:
-            source.close()
-        bar.close()
-        log_file.close()
-        if tb is not None:
-            tb.close()
-        if env is not None:
-            env.close()
-    state["elapsed"] = time.time() - t_start
-    _save(ckpt_path, model, opt_critic, opt_actor, replay, rng, gen, state, cfg)
-    torch.save(model.state_dict(), out / "policy.pt")
+        # The final checkpoint comes first: whatever else fails on the way out, the run can resume.
+        state["elapsed"] = time.time() - t_start
+        try:
+            _save(ckpt_path, model, opt_critic, opt_actor, replay, rng, gen, state, cfg)
+        finally:
+            if source is not None:
+                source.close()
+            bar.close()
+            log_file.close()
+            if tb is not None:
+                tb.close()
+            if env is not None:
+                env.close()
+    trained = state["n_updates"] > 0
+    policy_path = out / "policy.pt"
+    if trained:
+        weights_file.save(policy_path, dict(model=model.state_dict()),
+                          weights_file.make_meta(cfg.primitive, "policy", sensor=cfg.sensor, n_points=cfg.n_points,
+                                                 steps=state["global_step"], updates=state["n_updates"]))
+    else:
+        policy_path.unlink(missing_ok=True)
+        print(f"warning: no updates were made ({state['global_step']} steps, learning starts at "
+              f"{cfg.learning_starts} transitions): no policy.pt written; run longer (--steps) or lower "
+              "--learning-starts", file=sys.stderr)
     summary = dict(primitive=cfg.primitive, steps=state["global_step"], updates=state["n_updates"],
-                   minutes=state["elapsed"] / 60, invalid=state["invalid"],
+                   minutes=state["elapsed"] / 60, invalid=state["invalid"], trained=trained, interrupted=interrupted,
                    peak_rss_mb_learner=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
                    rss_samples=state["rss_samples"])
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     return summary
 
 
+def _truncate_log(path: Path, step: int) -> None:
+    """Keep the header and the rows of ``log.csv`` at or before ``step`` (atomic rewrite)."""
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    kept = rows[:1] + [r for r in rows[1:] if r and r[0].isdigit() and int(r[0]) <= step]
+    tmp = path.with_suffix(".csv.tmp")
+    with open(tmp, "w", newline="") as f:
+        csv.writer(f).writerows(kept)
+    os.replace(tmp, path)
+
+
 def _save(path, model, opt_critic, opt_actor, replay, rng, gen, state, cfg) -> None:
     ckpt.save(path, dict(model=model.state_dict(), opt_critic=opt_critic.state_dict(),
                          opt_actor=opt_actor.state_dict(), replay=replay.state(), rng=rng.bit_generator.state,
-                         gen=gen.get_state(), state=state, config=asdict(cfg)))
+                         gen=gen.get_state(), state=state, config=asdict(cfg)),
+              weights_file.make_meta(cfg.primitive, "checkpoint", sensor=cfg.sensor, n_points=cfg.n_points))
 
 
 def _tensorboard(out: Path):
@@ -375,6 +479,14 @@ def _tensorboard(out: Path):
     except ImportError:  # tensorboard not installed: CSV logs only
         return None
     return SummaryWriter(str(out / "tb"))
+
+
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """--help keeps the epilog's layout and shows every default."""
+
+
+def _raise_interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -388,10 +500,15 @@ def build_parser() -> argparse.ArgumentParser:
                "  python -m primitives.train push --backend ray --workers 4 --out runs/push  # local Ray instance\n"
                "  python -m primitives.train push --backend ray --ray-address auto --workers 32  # Ray cluster\n"
                "see docs/training.md",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_HelpFormatter,
     )
     d = TrainConfig()
     p.add_argument("primitive", choices=PRIMITIVES)
+    p.add_argument("--objects", default=d.objects,
+                   help="what trains: train (procedural), housekeep:training (HACMan's household training meshes), "
+                        "seed7, joined by +")
+    p.add_argument("--sensor", choices=("cameras", "surface"), default=d.sensor,
+                   help="how the policy sees the object: depth cameras, or the privileged surface sample")
     p.add_argument("--steps", type=int, default=d.steps, help="primitives to execute (default: %(default)s)")
     p.add_argument("--workers", type=int, default=d.workers,
                    help="rollout workers (processes, or Ray actors with --backend ray); 0 = in-process")
@@ -436,7 +553,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     cfg = TrainConfig(
-        primitive=args.primitive, steps=args.steps, workers=args.workers, backend=args.backend,
+        primitive=args.primitive, objects=args.objects, sensor=args.sensor,
+        steps=args.steps, workers=args.workers, backend=args.backend,
         ray_address=args.ray_address, seed=args.seed,
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
         lr=args.lr, replay_size=args.replay_size, learning_starts=args.learning_starts,
@@ -451,12 +569,17 @@ def main(argv: list[str] | None = None) -> int:
             import_ray()  # the optional dependency: fail now, saying how to install it
     except (InputError, ImportError) as exc:
         parser.error(str(exc))
+    signal.signal(signal.SIGTERM, _raise_interrupt)  # a polite kill stops like Ctrl-C: checkpoint, then exit
     try:
         summary = train(cfg, resume=args.resume)
-    except ckpt.CheckpointError as exc:  # a damaged checkpoint: say which file and why, not a traceback
+    except (InputError, ckpt.CheckpointError) as exc:  # one line, not a traceback
         print(f"{parser.prog}: error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps({k: v for k, v in summary.items() if k != "rss_samples"}, indent=2))
+    if summary["interrupted"]:
+        print(f"interrupted at step {summary['steps']}: checkpoint saved; continue with --resume --out {cfg.out}",
+              file=sys.stderr)
+        return 130
     return 0
 
 

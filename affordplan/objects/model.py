@@ -18,13 +18,14 @@ from __future__ import annotations
 import functools
 import math
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
 from affordplan.errors import InputError, MeshError
-from affordplan.objects import decompose, family, repair
+from affordplan.objects import decompose, family, housekeep, repair
 from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states, yaw_period
 from affordplan.objects.shapes import CATALOGUE, Shape
 
@@ -152,11 +153,16 @@ def _read_mesh(path: Path) -> trimesh.Trimesh:
     return loaded
 
 
-def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float, density: float, what: str) -> ObjectModel:
+def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float, density: float, what: str,
+               shipped: str | None = None) -> ObjectModel:
+    """``shipped``: a household object's name, whose convex parts are shipped (:mod:`.housekeep`)."""
     made = repair.solid(repair.clean(mesh, what), what)
     # Decompose in a normalised frame so cache keys do not depend on the source's units.
     probe = _finish(name, made.surface, made.volume, [], size, density)
-    if made.soup:  # CoACD can take minutes on a soup, for nothing: its hull is its shape
+    vertices = housekeep.shipped_parts(shipped, probe.mesh.vertices, size) if shipped else None
+    if vertices:
+        parts = [trimesh.convex.convex_hull(v) for v in vertices]
+    elif made.soup:  # CoACD can take minutes on a soup, for nothing: its hull is its shape
         parts = [probe.mesh.convex_hull]
     else:
         parts = decompose.convex_parts(probe.mesh, volume=probe.mass / density if made.closed else None)
@@ -173,7 +179,8 @@ def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_
     """Load an object and normalise it.
 
     Args:
-        source: a catalogue name (see :func:`catalogue`), a mesh file path, or a ``trimesh.Trimesh``.
+        source: a catalogue name (see :func:`catalogue`), ``"housekeep/NAME"`` (HACMan's household meshes,
+            :func:`affordplan.objects.housekeep.names`), a mesh file path, or a ``trimesh.Trimesh``.
         size: the largest half-extent after normalisation, metres.
         density: kg/m^3, for the mass and inertia.
 
@@ -195,6 +202,11 @@ def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_
         text = os.fspath(source)
         if text in CATALOGUE:
             return _from_shape(text, CATALOGUE[text](), size, density)
+        if text.startswith(housekeep.PREFIX):
+            path = housekeep.mesh_path(text)
+            with warnings.catch_warnings():  # their repairs are known and documented (PROVENANCE.md), not news
+                warnings.simplefilter("ignore", UserWarning)
+                return _from_mesh(text, _read_mesh(path), size, density, f"mesh {text}", shipped=text)
         path = Path(text)
         if path.exists() or path.suffix.lower() in MESH_SUFFIXES:
             return _from_mesh(path.stem, _read_mesh(path), size, density, f"mesh {path.name}")

@@ -22,17 +22,19 @@ import mujoco
 import numpy as np
 from scipy.spatial import cKDTree
 
-from affordplan.errors import InputError, ReachabilityError
+from affordplan.errors import InputError, PerceptionError, ReachabilityError
 from affordplan.geometry import check_pose, make_pose, relative_rotation, transform_points
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.arm import HOME, ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
 from affordplan.sim.pushers import ArmPusher, FingerPusher
 from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf
+from affordplan.sim.sensor import SENSORS, TABLE_CONTACT_HEIGHT, CameraSensor
 from affordplan.world import Box, Workspace
 
+MAX_CLOUD_POINTS = 100_000  # most points one cloud may ask for
 CHUNK_STEPS = 10  # physics steps between target updates and guard checks (20 ms)
-TABLE_CONTACT_HEIGHT = 0.003  # points lower than this touch the table and are not observed, metres
+__all__ = ["CHUNK_STEPS", "TABLE_CONTACT_HEIGHT", "Outcome", "Protocol", "SimState", "Simulator"]
 
 
 @dataclass(frozen=True)
@@ -119,17 +121,21 @@ class Simulator:
         obstacles: boxes standing on the table.
         pusher: ``"finger"`` (a force-limited fingertip on slide joints; fast, for training) or ``"arm"``
             (a 7-DOF arm driven by mink IK; see :mod:`affordplan.sim.arm`).
-        seed: seeds the point-cloud sampling; physics itself is deterministic.
+        seed: seeds the point-cloud sampling and the sensor's noise; physics itself is deterministic.
+        sensor: ``"cameras"`` (depth cameras, :mod:`affordplan.sim.sensor`; the default) or ``"surface"`` (the
+            privileged even sample of the true surface, for ablations only); see :meth:`point_cloud`.
         workspace: where objects live; the guards allow a margin around it.
     """
 
     def __init__(
         self, obj: ObjectModel, obstacles=(), pusher: str = "finger", seed: int = 0,
         workspace: Workspace = Workspace(), protocol: Protocol = Protocol(),
-        guard_limits: GuardLimits = GuardLimits(),
+        guard_limits: GuardLimits = GuardLimits(), sensor: str = "cameras",
     ):
         if pusher not in PUSHERS:
             raise InputError(f"unknown pusher {pusher!r}; expected one of {PUSHERS}")
+        if sensor not in SENSORS:
+            raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
         if not isinstance(obj, ObjectModel):
             raise InputError(f"obj must be an ObjectModel (see affordplan.load_object), got {type(obj).__name__}")
         obstacles = tuple(obstacles)
@@ -139,6 +145,7 @@ class Simulator:
         self.obj = obj
         self.obstacles: tuple[Box, ...] = obstacles
         self.pusher = pusher
+        self.sensor = sensor
         self.workspace = workspace
         self.protocol = protocol
         self.model = mujoco.MjModel.from_xml_string(build_mjcf(obj, self.obstacles, pusher))
@@ -167,6 +174,8 @@ class Simulator:
         self._guard = PhysicsGuard(m, self.data, self._object_body, hull[::step], workspace, guard_limits)
         self._samples_obj, self._normals_obj = obj.surface_samples()
         self._kdtree = cKDTree(self._samples_obj)
+        self._camera = CameraSensor(m, self._object_body) if sensor == "cameras" else None
+        self._radius = float(np.max(np.linalg.norm(obj.hull.vertices, axis=1)))
         self.physics_time = 0.0  # seconds spent inside mj_step, for benchmarks
         self.physics_steps = 0
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
@@ -227,15 +236,26 @@ class Simulator:
         return make_pose(R.reshape(3, 3), q[:3])
 
     def point_cloud(self, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
-        """``n`` points on the object's surface and their outward normals, world frame.
+        """``n`` points on the object's surface and their outward unit normals, world frame.
 
-        Points are drawn (with the simulator's seeded generator) from a fixed, evenly spread sample
-        of the mesh surface; points touching the table are left out. A real depth camera would also
-        miss self-occluded surface, add noise and holes at grazing angles, and see the table and
-        obstacles, which need segmenting out.
+        ``sensor="cameras"`` (the default): the object as the depth cameras of :mod:`affordplan.sim.sensor` see it,
+        segmented out by geom, with range noise, dropout and holes at grazing angles; what the table, obstacles or
+        the arm hide is missing; normals are estimated from the cloud. ``sensor="surface"``: an even sample of the
+        true surface with its exact normals (privileged; for ablations). Either way points touching the table are
+        left out and the points are drawn with the simulator's seeded generator.
+
+        Raises:
+            InputError: ``n`` is not a whole number in [1, 100000].
+            PerceptionError: no camera sees the object (it is hidden behind obstacles or the arm).
         """
-        if not isinstance(n, (int, np.integer)) or n <= 0:
-            raise InputError(f"n must be a positive integer, got {n!r}")
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 0 < n <= MAX_CLOUD_POINTS:
+            raise InputError(f"n must be a whole number in [1, {MAX_CLOUD_POINTS}], got {str(n)[:40]}")
+        if self._camera is not None:
+            mujoco.mj_kinematics(self.model, self.data)
+            points, normals = self._camera.cloud(self.data, self._rng, self._radius, int(n))
+            if len(points) == 0:
+                raise PerceptionError("no camera sees the object (hidden behind obstacles or the arm)")
+            return points, normals
         T = self.object_pose()
         points = transform_points(T, self._samples_obj)
         normals = self._normals_obj @ T[:3, :3].T

@@ -1,0 +1,177 @@
+"""The weights file format: tensors and plain metadata, loaded without running any code.
+
+Every file affordplan writes (a policy, a success model, a training checkpoint) is a ``torch.save`` of::
+
+    {"meta": {"format": "affordplan-weights", "format_version": 1, "skill": "push", "kind": "policy",
+              "sensor": "cameras", "n_points": 256, "version": "0.24.0", ...},
+     "payload": {...tensors, numbers, strings, lists and dicts...}}
+
+and is read back with ``torch.load(..., weights_only=True)``: torch's restricted unpickler, which builds tensors and
+plain containers only, so a file made to run code when unpickled is refused, never executed. NumPy arrays in a payload
+are stored as tensors (:func:`to_storable`). A file is checked against what the caller asks for (skill, kind), by its
+metadata, before any of its tensors reach a model, so a roll file given as push weights is refused with both names.
+
+Files written before this format (a bare policy ``state_dict``, or ``{"model": ..., "info": ...}``) carry no
+metadata; :func:`load` refuses them, and ``python -m primitives.weights_file stamp FILE --skill S --kind K`` adds it
+(after loading the file safely).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pickle
+import sys
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from affordplan.errors import WeightsError
+
+FORMAT = "affordplan-weights"
+FORMAT_VERSION = 1
+KINDS = ("policy", "success", "checkpoint")
+SKILLS = ("push", "roll", "spin")
+SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one place that knows where they live
+
+
+def to_storable(value: Any) -> Any:
+    """``value`` with every NumPy array and scalar turned into a tensor or a Python number (recursively)."""
+    if isinstance(value, np.ndarray):
+        return torch.from_numpy(np.ascontiguousarray(value))
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {k: to_storable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return type(value)(to_storable(v) for v in value)
+    return value
+
+
+def make_meta(skill: str, kind: str, **extra: Any) -> dict:
+    """The metadata of a file of ``kind`` for ``skill``; ``extra`` (plain values) is kept alongside."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        release = version("affordplan")
+    except PackageNotFoundError:  # run from a source tree that was never installed
+        release = "unknown"
+    return dict(format=FORMAT, format_version=FORMAT_VERSION, skill=skill, kind=kind, version=release,
+                **to_storable(extra))
+
+
+def save(path: str | os.PathLike, payload: Mapping, meta: Mapping) -> None:
+    """Write ``{"meta": meta, "payload": payload}`` atomically: to a temporary file in the same folder, fsynced, then
+    renamed over ``path``; temporary files a killed earlier write left behind are removed."""
+    if meta.get("format") != FORMAT or meta.get("kind") not in KINDS:
+        raise WeightsError(f"not affordplan weights metadata: {dict(meta)!r:.200}")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    for stale in path.parent.glob(f"{path.name}*.tmp"):
+        stale.unlink(missing_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            torch.save(dict(meta=dict(meta), payload=to_storable(dict(payload))), f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def read(path: str | os.PathLike) -> Any:
+    """Whatever ``path`` holds, through torch's restricted unpickler (tensors and plain containers only).
+
+    Raises:
+        WeightsError: no such file, a folder, a damaged or truncated file, or one that would run code to load.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise WeightsError(f"no weights file at {path}")
+    if path.is_dir():
+        raise WeightsError(f"{path} is a folder, not a weights file")
+    try:
+        return torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:  # torch raises several types; UnpicklingError for anything beyond tensors
+        text = str(exc).strip().splitlines()
+        first = text[0][:200] if text else type(exc).__name__
+        if "Weights only load failed" in str(exc) or isinstance(exc, pickle.UnpicklingError):
+            raise WeightsError(f"{path} is not a safe weights file: it holds objects other than tensors and plain "
+                               f"values (loading it could run code), so it was not loaded ({first})") from exc
+        raise WeightsError(f"{path} is damaged or truncated ({type(exc).__name__}: {first})") from exc
+
+
+def load(path: str | os.PathLike, *, kind: str, skill: str | None = None) -> tuple[dict, dict]:
+    """``(payload, meta)`` of the affordplan weights file ``path``, checked to be a ``kind`` file for ``skill``.
+
+    Raises:
+        WeightsError: see :func:`read`; no affordplan metadata; another kind, skill or format version.
+    """
+    content = read(path)
+    meta = content.get("meta") if isinstance(content, dict) else None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT or not isinstance(content.get("payload"), dict):
+        raise WeightsError(f"{path} carries no affordplan weights metadata (written by an older release or another "
+                           f"program); if it is yours, add it with: python -m primitives.weights_file stamp {path} "
+                           f"--skill SKILL --kind {kind}")
+    if meta.get("format_version") != FORMAT_VERSION:
+        raise WeightsError(f"{path} is format version {meta.get('format_version')!r:.40}; this release reads "
+                           f"{FORMAT_VERSION}")
+    if meta.get("kind") != kind:
+        raise WeightsError(f"{path} holds a {str(meta.get('kind'))[:40]} file, not a {kind}")
+    if skill is not None and meta.get("skill") != skill:
+        raise WeightsError(f"{path} is for the {str(meta.get('skill'))[:40]} skill, not {skill}")
+    return content["payload"], meta
+
+
+def stamp(path: str | os.PathLike, *, skill: str, kind: str, sensor: str = "surface") -> None:
+    """Rewrite an older (metadata-less) file in this format, after loading it safely: a policy's bare
+    ``state_dict`` becomes ``{"model": state_dict}``; a success model's ``{"model", "info"}`` is kept."""
+    if skill not in SKILLS or kind not in ("policy", "success"):
+        raise WeightsError(f"stamp takes a skill in {SKILLS} and a kind 'policy' or 'success'")
+    content = read(path)
+    if isinstance(content, dict) and content.get("meta", {}).get("format") == FORMAT:
+        raise WeightsError(f"{path} already carries affordplan metadata")
+    if kind == "policy":
+        payload = dict(model=content.get("model", content) if isinstance(content, dict) else content)
+    else:
+        if not isinstance(content, dict) or "model" not in content:
+            raise WeightsError(f"{path} is not a success model (no 'model' entry)")
+        payload = dict(content)
+    save(path, payload, make_meta(skill, kind, sensor=sensor))
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m primitives.weights_file",
+                                description="Inspect affordplan weights files, or stamp an older one with metadata.")
+    sub = p.add_subparsers(dest="command", required=True)
+    show = sub.add_parser("show", help="print a file's metadata")
+    show.add_argument("path", type=Path)
+    st = sub.add_parser("stamp", help="add metadata to a file written before the format had it")
+    st.add_argument("path", type=Path)
+    st.add_argument("--skill", required=True, choices=SKILLS)
+    st.add_argument("--kind", required=True, choices=("policy", "success"))
+    st.add_argument("--sensor", default="surface", choices=("surface", "cameras"),
+                    help="the clouds it was trained on (default: %(default)s, what every release before 0.24 used)")
+    args = p.parse_args(argv)
+    try:
+        if args.command == "show":
+            content = read(args.path)
+            meta = content.get("meta") if isinstance(content, dict) else None
+            print(meta if meta else "no affordplan metadata")
+        else:
+            stamp(args.path, skill=args.skill, kind=args.kind, sensor=args.sensor)
+    except WeightsError as exc:
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
