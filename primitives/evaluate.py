@@ -24,6 +24,7 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
+from affordplan.objects import housekeep
 from primitives.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
@@ -49,6 +50,7 @@ class EvalResult:
     predicted: list[float] = field(default_factory=list)  # the success model's rating of each trial (frame search)
     outcomes: list[bool] = field(default_factory=list)  # every trial's success, in order
     acted_as: list[dict | None] = field(default_factory=list)  # each trial's stand-in request (frame search only)
+    sensor: str = "cameras"
 
     @property
     def success_rate(self) -> float:
@@ -67,7 +69,7 @@ class EvalResult:
         return metrics(np.array(self.predicted), np.array(self.outcomes, dtype=bool))
 
     def as_dict(self) -> dict:
-        out = dict(primitive=self.primitive, objects=self.objects, success=self.success_rate,
+        out = dict(primitive=self.primitive, objects=self.objects, sensor=self.sensor, success=self.success_rate,
                    trials=sum(len(v) for v in self.per_object.values()), invalid=self.invalid, params=self.params,
                    per_object=self.rates())
         if self.predicted:
@@ -79,13 +81,43 @@ class EvalResult:
         return out
 
 
-def held_out_config(primitive: str, p_params: float) -> EnvConfig:
+# The seed's seven objects' real counterparts among HACMan's household meshes (one each; the shared README's map).
+SEED_SEVEN_REAL = {
+    "cube": "rubiks_cube_077_rubiks_cube_M", "mug": "mug_025_mug_M",
+    "tape": "tape_3M_Antislip_Surfacing_Light_Duty_White_M",
+    "planter_1": "plant_container_Central_Garden_Flower_Pot_Goo_425_M",
+    "planter_2": "plant_container_Sapota_Threshold_4_Ceramic_Round_Planter_Red_M",
+    "pill_bottle": "pill_bottle_Beta_Glucan_M", "lunch_box": "lunch_bag_Olive_Kids_Birdie_Munch_n_Lunch_M",
+}
+
+
+def held_out_config(primitive: str, p_params: float, sensor: str = "cameras") -> EnvConfig:
     """The environment of the held-out starts (procedural test split, one episode per drawn object)."""
-    return EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1, p_params=p_params)
+    return EnvConfig(primitive, objects="test", n_objects=200, episodes_per_object=1, p_params=p_params,
+                     sensor=sensor)
+
+
+def object_list(objects: str | tuple[str, ...]) -> tuple[str, ...]:
+    """The objects an evaluation runs on: ``seed7`` (the seed's procedural seven), ``seed7:real`` (their real
+    counterparts, :data:`SEED_SEVEN_REAL`), ``housekeep:SPLIT`` (e.g. ``housekeep:unseen``), or names / paths."""
+    if objects == "seed7":
+        return SEED_SEVEN
+    if objects == "seed7:real":
+        return tuple(housekeep.PREFIX + SEED_SEVEN_REAL[n] for n in SEED_SEVEN)
+    if isinstance(objects, str) and objects.startswith("housekeep:"):
+        return tuple(housekeep.PREFIX + n for n in housekeep.names(objects.split(":", 1)[1]))
+    return (objects,) if isinstance(objects, str) else tuple(objects)
+
+
+def seed_reference(name: str) -> tuple[float, float, float] | None:
+    """The seed's Fig. 5 figures (push, roll, spin) for a seed object or its real counterpart."""
+    real = {housekeep.PREFIX + v: k for k, v in SEED_SEVEN_REAL.items()}
+    return SEED_FIG5.get(real.get(name, name))
 
 
 def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str, ...] = "random",
              trials: int = 200, seed: int = 1234, progress: bool = True, p_params: float = 0.0,
+             sensor: str = "cameras",
              frame_search: FrameSearch | None = None,
              success_weights: str | os.PathLike | None = None) -> EvalResult:
     """Success over ``trials`` stable starts (per object for ``seed7`` and paths).
@@ -101,14 +133,14 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
 
         predict = SuccessModel(model, load_success_net(primitive, success_weights)).predict
     if objects == "random":
-        cfg = held_out_config(primitive, p_params)
+        cfg = held_out_config(primitive, p_params, sensor)
         plan = [None] * trials
     else:
-        names = SEED_SEVEN if objects == "seed7" else tuple(objects)
-        cfg = EnvConfig(primitive, objects=names, episodes_per_object=1, p_params=p_params)
+        names = object_list(objects)
+        cfg = EnvConfig(primitive, objects=names, episodes_per_object=1, p_params=p_params, sensor=sensor)
         plan = [n for n in names for _ in range(trials)]
     env = PrimitiveEnv(cfg, seed=seed)
-    result = EvalResult(primitive, objects if isinstance(objects, str) else "paths",
+    result = EvalResult(primitive, objects if isinstance(objects, str) else "paths", sensor=sensor,
                         params={0.0: "none", 1.0: "random"}.get(p_params, f"p={p_params:.2f}"))
     for key in tqdm(plan, desc=f"evaluate {primitive}", disable=not progress, unit="trial", mininterval=2.0):
         obs = env.reset(object_key=key)
@@ -161,11 +193,12 @@ def plot_results(results: list[EvalResult], path: str | os.PathLike) -> None:
         for k, r in enumerate(per_obj):
             col = PRIMITIVES.index(r.primitive)
             xs = np.arange(len(objs))
-            ax.bar(xs + (2 * k) * width - 0.4, [SEED_FIG5.get(o, (np.nan,) * 3)[col] for o in objs], width,
+            ax.bar(xs + (2 * k) * width - 0.4, [(seed_reference(o) or (np.nan,) * 3)[col] for o in objs], width,
                    color="#bbbbbb", label="seed" if k == 0 else None)
             ax.bar(xs + (2 * k + 1) * width - 0.4, [r.rates()[o] for o in objs], width,
                    label=f"affordplan {r.primitive}")
-        ax.set_xticks(np.arange(len(objs)), objs, rotation=20)
+        ax.set_xticks(np.arange(len(objs)), [o.removeprefix(housekeep.PREFIX)[:18] for o in objs], rotation=30,
+                      ha="right", fontsize=7)
         ax.set_ylim(0, 1)
         ax.set_title("success per object (grey: seed's Fig. 5)")
         ax.legend(fontsize=8)
@@ -211,7 +244,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("primitive", choices=PRIMITIVES)
     p.add_argument("--weights", default=None, help="policy.pt or checkpoint.pt (default: shipped weights)")
     p.add_argument("--trials", type=int, default=200)
-    p.add_argument("--objects", nargs="+", default=["random"], help="random | seed7 | mesh paths")
+    p.add_argument("--objects", nargs="+", default=["random"],
+                   help="random (procedural test split) | seed7 | seed7:real | housekeep:SPLIT (e.g. housekeep:unseen, "
+                        "housekeep:unseen_thick, housekeep:validation) | names or mesh paths; --trials each")
+    p.add_argument("--sensor", choices=("cameras", "surface"), default="cameras",
+                   help="how the policy sees the object (surface: the privileged sample, for ablations)")
     p.add_argument("--seed", type=int, default=1234)
     p.add_argument("--params", choices=["none", "random"], default="none",
                    help="none: the seed's objective; random: every trial asks for a random parameter")
@@ -256,11 +293,12 @@ def main(argv: list[str] | None = None) -> int:
     torch.set_num_threads(1)
     try:
         model = load_policy(args.weights, args.primitive)
-        objects = args.objects[0] if args.objects[0] in ("random", "seed7") else tuple(args.objects)
+        objects = args.objects[0] if len(args.objects) == 1 and ":" in args.objects[0] or args.objects[0] in (
+            "random", "seed7") else tuple(args.objects)
         search = _frame_search(args, parser)
         result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
                           p_params=1.0 if args.params == "random" else 0.0, frame_search=search,
-                          success_weights=args.success_weights)
+                          success_weights=args.success_weights, sensor=args.sensor)
     except AffordplanError as exc:  # missing or broken weights, an unreadable mesh, ...
         print(f"primitives.evaluate: error: {exc}", file=sys.stderr)
         return 2
@@ -278,7 +316,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  acted as a stand-in request on {d['stand_in_share']:.3f} of the trials "
                   f"(success there {d['stand_in_success']:.3f})")
         for name, rate in result.rates().items():
-            seed = SEED_FIG5.get(name)
+            seed = seed_reference(name)
             ref = f"   seed {seed[PRIMITIVES.index(args.primitive)]:.3f}" if seed else ""
             print(f"  {name:14s} {rate:.3f}{ref}")
     if args.plot:
