@@ -199,7 +199,10 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
     echo(str(plan))
 
     t_exec = time.perf_counter()
-    simulator = _NotifyingSimulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed)
+    from primitives.skills import skills_sensor
+
+    sensor = skills_sensor(plan.planner.predictor.skills)  # the clouds the shipped skills were trained on
+    simulator = _NotifyingSimulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed, sensor=sensor)
     simulator.set_object_pose(plan.start_pose)
     camera = camera or ("arm" if sim == "arm" else "overview")
     recorder = FrameRecorder(simulator, width, height, camera, frame_interval) if video else None

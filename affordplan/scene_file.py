@@ -223,7 +223,7 @@ def _known(d: Mapping, allowed: tuple[str, ...], source: str, prefix: str) -> No
     unknown = sorted(str(k) for k in d if k not in allowed)
     if unknown:
         where = f"{prefix}: " if prefix else ""
-        raise InputError(f"{source}: {where}unknown field(s) {', '.join(unknown)[:200]}; expected some of "
+        raise InputError(f"{source}: {where}unknown field(s) {str(unknown)[:200]}; expected some of "
                          f"{list(allowed)}")
 
 

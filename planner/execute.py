@@ -29,6 +29,7 @@ from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
 from planner.predict import expected_pose
 from primitives import params as skill_params
+from primitives.skills import skills_sensor
 
 XY_TOL = 0.025  # metres off the plan before replanning
 YAW_TOL = math.radians(12.0)
@@ -92,12 +93,15 @@ class Execution:
         return "\n".join([head] + [f"  {e}" for e in self.log])
 
 
-def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int) -> Simulator:
+def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int, sensor: str = "cameras"
+               ) -> Simulator:
+    """``sim`` itself, or a new ``"arm"`` / ``"finger"`` simulator that shows the skills ``sensor``'s clouds (the
+    sensor their weights were trained on, :func:`primitives.skills.skills_sensor`)."""
     if isinstance(sim, Simulator):
         return sim
     if sim not in ("arm", "finger"):
         raise AffordplanError(f"sim must be 'arm', 'finger' or a Simulator, got {sim!r}")
-    s = Simulator(obj, obstacles=obstacles, pusher=sim, seed=seed)
+    s = Simulator(obj, obstacles=obstacles, pusher=sim, seed=seed, sensor=sensor)
     s.set_object_pose(T_start)
     return s
 
@@ -179,7 +183,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
     """Run ``plan`` closed-loop (see the module docstring)."""
     planner, goal = plan.planner, plan.goal
     obj = planner.obj
-    sim = _simulator(sim, obj, planner.obstacles, plan.start_pose, seed)
+    sim = _simulator(sim, obj, planner.obstacles, plan.start_pose, seed, skills_sensor(planner.predictor.skills))
     steps, k = list(plan.steps), 0
     log: list[LogEntry] = []
     frames: list[np.ndarray] = []
@@ -245,7 +249,7 @@ def greedy_calls(obj: ObjectModel, state: int) -> list[tuple[str, dict]]:
 def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor, sim="arm", obstacles=(),
                    max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
     """The greedy baseline (see the module docstring)."""
-    sim = _simulator(sim, obj, obstacles, T_start, seed)
+    sim = _simulator(sim, obj, obstacles, T_start, seed, skills_sensor(predictor.skills))
     log: list[LogEntry] = []
     frames: list[np.ndarray] = []
     _record_frame(sim, render, frames)

@@ -182,7 +182,7 @@ class Planner:
         self.obj = obj
         self.obstacles = tuple(obstacles)
         self.workspace = workspace
-        self.predictor = predictor or Predictor(obj, seed=seed)
+        self.predictor = predictor or Predictor(obj, seed=seed, obstacles=tuple(obstacles))
         self.time_limit = float(time_limit)
         self.seed = int(seed)
         self.clearance = clearance

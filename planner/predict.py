@@ -1,9 +1,11 @@
 """What the planner expects of a skill: its ideal effect on the pose, and its predicted success.
 
 The planner reasons about poses it has not reached yet, so it cannot ask a simulator for a point
-cloud there. It draws the cloud the simulator would see from the object model posed at the expected
-pose (the same surface sample, points touching the table left out; :meth:`affordplan.Simulator.point_cloud`)
-and asks the skill's success model. The *ideal effect* of a skill is the rigid motion its parameter
+cloud there. It draws the cloud the skills' sensor (:func:`primitives.skills.skills_sensor`, the one their weights
+were trained on) would return with the object at the expected pose, through the simulator's own sensor model
+(:mod:`affordplan.sim.sensor`): for ``"cameras"`` the same depth cameras cast their rays into a scene of the table,
+the obstacles and the object posed there; for ``"surface"`` the same surface sample. It then asks the skill's success
+model. The *ideal effect* of a skill is the rigid motion its parameter
 names (:func:`primitives.params.goal_transform`), followed, for a roll, by settling into the target
 state at the same place on the table.
 """
@@ -12,15 +14,17 @@ from __future__ import annotations
 
 import os
 
+import mujoco
 import numpy as np
 
 from affordplan.errors import InputError
-from affordplan.geometry import transform_points
 from affordplan.objects.model import ObjectModel
-from affordplan.sim.simulator import TABLE_CONTACT_HEIGHT
+from affordplan.sim.scene import OBJECT_BODY, build_mjcf
+from affordplan.sim.sensor import CameraSensor, surface_cloud
+from affordplan.world import Box
 from primitives import params as skill_params
 from primitives.env import observe_cloud
-from primitives.skills import Skill, load_skills
+from primitives.skills import Skill, load_skills, skills_sensor
 
 N_POINTS = 256
 SKILLS = ("push", "spin", "roll")
@@ -54,29 +58,56 @@ class Predictor:
             folder (:func:`primitives.skills.load_skills`: a candidate set; a skill without files there shipped).
         seed: seeds the choice of cloud points (queries are deterministic for a given seed).
         weights_dir: see ``skills``; not combined with it.
+        obstacles: boxes that occlude the cameras' view of predicted poses.
 
     Raises:
         InputError: both ``skills`` and ``weights_dir``, or an unusable ``weights_dir``.
     """
 
     def __init__(self, obj: ObjectModel, skills: dict[str, Skill] | None = None, seed: int = 0,
-                 weights_dir: str | os.PathLike | None = None):
+                 weights_dir: str | os.PathLike | None = None, obstacles: tuple[Box, ...] = ()):
         if skills is not None and weights_dir is not None:
             raise InputError("give skills or weights_dir, not both")
         self.obj = obj
         self.skills = skills or load_skills(weights_dir)
+        self.sensor = skills_sensor(self.skills)
+        self.obstacles = tuple(obstacles)
         self._samples, self._normals = obj.surface_samples()
         self._seed = seed
+        self._cameras: tuple[mujoco.MjData, CameraSensor, int] | None = None
         self.queries = 0
+
+    def _camera_scene(self) -> tuple[mujoco.MjData, CameraSensor, int]:
+        """The scene the cameras look into (table, obstacles, the object; the finger parked out of view), built on
+        first use."""
+        if self._cameras is None:
+            model = mujoco.MjModel.from_xml_string(build_mjcf(self.obj, self.obstacles, "finger"))
+            body = model.body(OBJECT_BODY).id
+            self._cameras = (mujoco.MjData(model), CameraSensor(model, body),
+                             int(model.jnt_qposadr[model.body_jntadr[body]]))
+        return self._cameras
+
+    def cloud(self, T_world_object: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``N_POINTS`` points and normals (world) that the skills' sensor returns with the object at a settled
+        pose; the surface sample where no camera would see it."""
+        rng = np.random.default_rng(self._seed)
+        if self.sensor == "cameras":
+            data, camera, adr = self._camera_scene()
+            quat = np.empty(4)
+            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T_world_object[:3, :3]).reshape(-1))
+            data.qpos[adr:adr + 3] = T_world_object[:3, 3]
+            data.qpos[adr + 3:adr + 7] = quat
+            mujoco.mj_kinematics(camera.model, data)
+            radius = float(np.max(np.linalg.norm(self.obj.hull.vertices, axis=1)))
+            points, normals = camera.cloud(data, rng, radius, N_POINTS)
+            if len(points):
+                return points, normals
+        return surface_cloud(self._samples, self._normals, T_world_object, rng, N_POINTS)
 
     def observation(self, skill: str, params: dict | None, T_world_object: np.ndarray) -> np.ndarray:
         """The observation the skill's policy would get at ``T_world_object`` (a settled pose)."""
-        points = transform_points(T_world_object, self._samples)
-        normals = self._normals @ T_world_object[:3, :3].T
-        visible = np.flatnonzero(points[:, 2] > TABLE_CONTACT_HEIGHT)
-        rng = np.random.default_rng(self._seed)
-        idx = rng.choice(visible, size=N_POINTS, replace=len(visible) < N_POINTS)
-        return observe_cloud(self.obj, skill, params, points[idx], normals[idx], T_world_object).obs
+        points, normals = self.cloud(T_world_object)
+        return observe_cloud(self.obj, skill, params, points, normals, T_world_object).obs
 
     def p_success(self, skill: str, params: dict | None, T_world_object: np.ndarray) -> float:
         """Predicted P(success) of ``skill`` with ``params`` at a settled pose."""

@@ -17,8 +17,12 @@ class CheckpointError(WeightsError):
     """A checkpoint file is missing, truncated, unsafe or not a checkpoint."""
 
 
-def save(path: str | Path, payload: dict, meta: dict) -> None:
-    """Write ``payload`` atomically to ``path`` with ``meta`` (:func:`primitives.weights_file.save`)."""
+def save(path: str | Path, payload: dict, meta: dict | None = None) -> None:
+    """Write ``payload`` atomically to ``path`` with ``meta`` (:func:`primitives.weights_file.save`; by default a
+    checkpoint of the skill ``payload["config"]["primitive"]`` names)."""
+    if meta is None:
+        skill = payload.get("config", {}).get("primitive", "push")
+        meta = weights_file.make_meta(skill, "checkpoint")
     weights_file.save(path, payload, meta)
 
 

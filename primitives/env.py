@@ -144,6 +144,29 @@ def check_env_config(config: EnvConfig) -> None:
     require_probability("EnvConfig.p_params", config.p_params)
     if config.sensor not in SENSORS:
         raise InputError(f"unknown sensor {config.sensor!r}; expected one of {SENSORS}")
+    object_groups(config.objects, config.n_objects)
+
+
+def object_groups(objects: str | tuple[str, ...], n_objects: int) -> list[list]:
+    """The object keys an environment draws from, in groups (see :class:`EnvConfig`; an episode draws a group
+    uniformly, then a key in it): procedural ``(split, index)`` pairs, or names and paths for :func:`load_object`.
+
+    Raises:
+        InputError: a ``housekeep:SPLIT`` naming no split.
+    """
+    if not isinstance(objects, str):
+        return [list(objects)]
+    groups = []
+    for spec in objects.split("+"):
+        if spec in ("train", "test"):
+            groups.append([(spec, i) for i in range(n_objects)])
+        elif spec == "seed7":
+            groups.append(list(SEED_SEVEN))
+        elif spec.startswith("housekeep:"):
+            groups.append([housekeep.PREFIX + name for name in housekeep.names(spec.split(":", 1)[1])])
+        else:  # a catalogue name, housekeep/NAME or a mesh path
+            groups.append([spec])
+    return groups
 
 
 def _lru(cache: OrderedDict, key, capacity: int, build: Callable[[], T], evict: Callable[[T], None] | None = None) -> T:
@@ -177,21 +200,7 @@ class PrimitiveEnv:
 
     # ------------------------------------------------------------------ objects
     def _object_groups(self) -> list[list]:
-        """The object keys to draw from, in groups (an episode draws a group uniformly, then a key in it)."""
-        c = self.config
-        if not isinstance(c.objects, str):
-            return [list(c.objects)]
-        groups = []
-        for spec in c.objects.split("+"):
-            if spec in ("train", "test"):
-                groups.append([(spec, i) for i in range(c.n_objects)])
-            elif spec == "seed7":
-                groups.append(list(SEED_SEVEN))
-            elif spec.startswith("housekeep:"):
-                groups.append([housekeep.PREFIX + name for name in housekeep.names(spec.split(":", 1)[1])])
-            else:
-                raise InputError(f"unknown object set {spec!r}: train, test, seed7 or housekeep:SPLIT")
-        return groups
+        return object_groups(self.config.objects, self.config.n_objects)
 
     def _load(self, key) -> ObjectModel:
         """The model of object ``key``, from the model cache when it was built before."""

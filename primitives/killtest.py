@@ -58,10 +58,12 @@ class Kill:
     stale_tmp_files: int = 0
     orphans: int = 0  # processes of the run still alive 2 s after the learner was killed
     orphan_commands: list[str] = field(default_factory=list)
+    signal: str = "KILL"
+    exit_ok: bool = True  # INT / TERM: the run saved and exited with status 130 by itself
 
     @property
     def ok(self) -> bool:
-        return self.resumed_from == self.checkpoint_step and self.orphans == 0
+        return self.resumed_from == self.checkpoint_step and self.orphans == 0 and self.exit_ok
 
 
 @dataclass
@@ -75,6 +77,7 @@ class KillTestResult:
     corrupt_checkpoint_error: str = ""  # what --resume from a truncated checkpoint printed
     corrupt_checkpoint_ok: bool | None = None  # None: not checked
     wall_s: float = 0.0
+    duplicated_log_rows: int = 0  # rows of the final log.csv whose step is not above the row before
 
     @property
     def max_lost_s(self) -> float:
@@ -83,6 +86,7 @@ class KillTestResult:
     @property
     def ok(self) -> bool:
         return (self.completed and self.final_steps == self.steps and all(k.ok for k in self.kills)
+                and self.duplicated_log_rows == 0
                 and self.max_lost_s <= self.interval_s + SLACK_S
                 and self.corrupt_checkpoint_ok is not False)
 
@@ -94,15 +98,18 @@ class KillTestResult:
     def report(self) -> str:
         lines = [f"killtest {self.primitive}: {len(self.kills)} kills, {self.steps} steps, checkpoint every "
                  f"{self.interval_s:.1f} s, {self.wall_s:.0f} s in all",
-                 "  kill  after_s  last_seen  ckpt_step  resumed_from  lost_steps  lost_s  tmp  orphans"]
+                 "  kill  signal  after_s  last_seen  ckpt_step  resumed_from  lost_steps  lost_s  tmp  orphans"]
         for k in self.kills:
-            lines.append(f"  {k.index:4d}  {k.after_s:7.1f}  {k.last_seen_step:9d}  {k.checkpoint_step:9d}  "
+            mark = "" if k.exit_ok else "!"
+            lines.append(f"  {k.index:4d}  {k.signal:>6s}{mark}  {k.after_s:7.1f}  {k.last_seen_step:9d}  "
+                         f"{k.checkpoint_step:9d}  "
                          f"{str(k.resumed_from):>12s}  {k.lost_steps:10d}  {k.lost_s:6.1f}  {k.stale_tmp_files:3d}  "
                          f"{k.orphans:7d}")
         lines += [
             f"  lost at most {self.max_lost_s:.1f} s of training per kill (bound: interval {self.interval_s:.1f} s "
             f"+ {SLACK_S:.0f} s slack)",
-            f"  final run completed: {self.completed} ({self.final_steps}/{self.steps} steps)",
+            f"  final run completed: {self.completed} ({self.final_steps}/{self.steps} steps); log rows logged twice: "
+            f"{self.duplicated_log_rows}",
             f"  --resume from a truncated checkpoint: {self.corrupt_checkpoint_error or '(not run)'}",
         ]
         orphaned = sorted({c for k in self.kills for c in k.orphan_commands})
@@ -217,12 +224,14 @@ def train_command(primitive: str, out: Path, steps: int, interval_s: float, work
 def killtest(primitive: str = "push", kills: int = 5, out: str | os.PathLike = "killtest", steps: int = 4000,
              interval_s: float = 3.0, workers: int = 0, seed: int = 0, timeout: float = 600.0,
              overwrite: bool = False, window: tuple[float, float] | None = None, check_truncated: bool = True,
-             log=print) -> KillTestResult:
+             log=print, signals: tuple[str, ...] = ("KILL",)) -> KillTestResult:
     """Run the kill-and-resume test (see the module docstring); ``out`` is created and must not exist
     unless ``overwrite``.
 
     ``window``: seconds after a run begins stepping within which its kill falls (uniformly; default
     ``(0.5, 3 * interval_s)``). ``check_truncated``: also check ``--resume`` from a truncated checkpoint.
+    ``signals``: what stops each run, in turn (``KILL``, ``INT``: Ctrl-C, ``TERM``); a run stopped by INT or TERM
+    must save a checkpoint and exit by itself (status 130).
     """
     low, high = window or (0.5, 3.0 * interval_s)
     root = Path(out)
@@ -265,9 +274,15 @@ def killtest(primitive: str = "push", kills: int = 5, out: str | os.PathLike = "
         if run.proc.poll() is not None:  # finished before its kill: nothing to kill, the test is too short
             raise RuntimeError(f"the run finished before kill {i + 1}; raise --steps")
         children = run.descendants()
+        name = signals[i % len(signals)]
         t_kill = time.time()
-        os.kill(run.proc.pid, signal.SIGKILL)
-        run.proc.wait()
+        os.kill(run.proc.pid, getattr(signal, f"SIG{name}"))
+        try:
+            run.proc.wait(timeout=60.0)
+        except subprocess.TimeoutExpired:  # INT / TERM ignored: a failure the report shows (exit status None)
+            run.kill_group()
+            run.proc.wait()
+        polite_ok = name == "KILL" or run.proc.returncode == 130
         time.sleep(2.0 if children else 0.2)  # give orphaned workers time to notice, if they can
         orphans = [pid for pid in children if _alive(pid)]
         orphan_commands = [_command(pid) for pid in orphans]
@@ -278,20 +293,31 @@ def killtest(primitive: str = "push", kills: int = 5, out: str | os.PathLike = "
             raise RuntimeError(f"the run had finished its {steps} steps before kill {i + 1}; raise --steps")
         rate = (seen_step - run.progress[0][1]) / max(seen_t - run.progress[0][0], 1e-9) if len(run.progress) > 1 else 0
         ckpt_step, ckpt_mtime = _checkpoint_step(run_dir / "checkpoint.pt")
-        since = t_kill - max(ckpt_mtime, started)
+        since = max(0.0, t_kill - max(ckpt_mtime, started))
         at_kill = seen_step + int(round(rate * (t_kill - seen_t)))
         stale = len(list(run_dir.glob("checkpoint.pt*.tmp")))
         pending = Kill(index=i + 1, after_s=t_kill - started, last_seen_step=seen_step,
                        lost_steps=max(0, at_kill - ckpt_step), lost_s=since, checkpoint_step=ckpt_step,
-                       stale_tmp_files=stale, orphans=len(orphans), orphan_commands=orphan_commands)
+                       stale_tmp_files=stale, orphans=len(orphans), orphan_commands=orphan_commands, signal=name,
+                       exit_ok=polite_ok)
         result.kills.append(pending)
         log(f"kill {i + 1}: {pending.after_s:.1f} s in, last seen step {seen_step}, checkpoint at step {ckpt_step} "
             f"({since:.1f} s before the kill), {len(orphans)} orphaned processes")
+    result.duplicated_log_rows = _duplicated_rows(run_dir / "log.csv")
     if check_truncated:
         result.corrupt_checkpoint_error, result.corrupt_checkpoint_ok = _check_truncated(
             primitive, root, run_dir, steps, interval_s, workers, seed, env)
     result.wall_s = time.time() - t0
     return result
+
+
+def _duplicated_rows(path: Path) -> int:
+    """Rows of a training log whose step is not above the previous row's (a resumed run logging steps again)."""
+    if not path.exists():
+        return 0
+    with open(path) as f:
+        steps = [int(line.split(",", 1)[0]) for line in f.read().splitlines()[1:] if line[:1].isdigit()]
+    return int(sum(b <= a for a, b in zip(steps, steps[1:])))
 
 
 def _check_truncated(primitive, root: Path, run_dir: Path, steps, interval_s, workers, seed, env) -> tuple[str, bool]:
@@ -319,7 +345,9 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("primitive", choices=["push", "roll", "spin"])
-    p.add_argument("--kills", type=int, default=5, help="SIGKILLs before the final run (default: %(default)s)")
+    p.add_argument("--kills", type=int, default=5, help="stops before the final run (default: %(default)s)")
+    p.add_argument("--signals", nargs="+", choices=("KILL", "INT", "TERM"), default=["KILL"],
+                   help="the signal of each stop, in turn (default: %(default)s)")
     p.add_argument("--out", required=True, help="folder for the run (created; must not exist)")
     p.add_argument("--steps", type=int, default=4000, help="primitives in the whole run (default: %(default)s)")
     p.add_argument("--checkpoint-seconds", type=float, default=3.0,
@@ -336,7 +364,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     quiet = (lambda *a, **k: None) if args.json else (lambda *a, **k: print(*a, **k, flush=True))
     result = killtest(args.primitive, args.kills, args.out, args.steps, args.checkpoint_seconds, args.workers,
-                      args.seed, args.timeout, args.overwrite, log=quiet)
+                      args.seed, args.timeout, args.overwrite, log=quiet, signals=tuple(args.signals))
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     return 0 if result.ok else 1
 

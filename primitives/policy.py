@@ -16,20 +16,24 @@ from primitives.weights_file import SHIPPED_DIR, load
 def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActorCritic:
     """The ``primitive``'s policy from a ``policy.pt`` / ``checkpoint.pt`` file, or the shipped weights.
 
+    The returned module's ``sensor`` attribute names the clouds it was trained on (its file's metadata:
+    ``"cameras"`` or ``"surface"``).
+
     Raises:
         WeightsError: missing, damaged or unsafe file, or one for another skill or kind of model.
     """
     path = Path(weights) if weights else SHIPPED_DIR / f"{primitive}.pt"
     if path.is_file() and path.name.startswith("checkpoint"):
-        payload, _ = load(path, kind="checkpoint", skill=primitive)
+        payload, meta = load(path, kind="checkpoint", skill=primitive)
     else:
-        payload, _ = load(path, kind="policy", skill=primitive)
+        payload, meta = load(path, kind="policy", skill=primitive)
     model = HybridActorCritic()
     try:
         model.load_state_dict(widen_input(payload["model"]))
     except (KeyError, RuntimeError, TypeError) as exc:
         raise WeightsError(f"{path} does not fit the policy network ({str(exc).splitlines()[0][:200]})") from exc
     model.eval()
+    model.sensor = str(meta.get("sensor", "surface"))
     return model
 
 

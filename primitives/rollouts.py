@@ -21,6 +21,7 @@ import logging
 import multiprocessing as mp
 import os
 import queue
+import signal
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -151,6 +152,10 @@ def _local_worker(env_config: EnvConfig, explore: Exploration, seed: int, weight
     A learner killed with SIGKILL never sets ``stop``: the worker then notices that its parent is gone
     (checked whenever the queue stays full for a second) and exits instead of blocking for good.
     """
+    # The learner owns stopping: Ctrl-C (sent to the whole terminal's process group) and the learner's SIGTERM
+    # handler are its own; a worker ignores SIGINT and ends on SIGTERM quietly, when ``close`` terminates it.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     parent = mp.parent_process()
     collector = Collector(env_config, explore, seed, weights_q.get())
     while not stop.is_set():
@@ -197,11 +202,21 @@ class LocalWorkers:
             wq.put(weights)
 
     def poll(self, timeout: float) -> list[Transition]:
+        """Transitions the workers have sent (waiting up to ``timeout`` s for the first).
+
+        Raises:
+            RuntimeError: nothing came and a worker has died (the learner would otherwise wait for it for good).
+        """
         got: list[Transition] = []
         while True:
             try:
                 got.append(self._out.get(timeout=timeout if not got else 0))
             except queue.Empty:
+                if not got:
+                    dead = [(i, p.exitcode) for i, p in enumerate(self._procs) if p.exitcode is not None]
+                    if dead:
+                        raise RuntimeError(f"rollout worker {dead[0][0]} died (exit code {dead[0][1]}); its error, "
+                                           "if any, is above") from None
                 return got
 
     def worker_rss_mb(self) -> float:

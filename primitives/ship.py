@@ -35,9 +35,8 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import torch
-
-from affordplan.errors import AffordplanError, InputError
+from affordplan.errors import AffordplanError, InputError, WeightsError
+from primitives import weights_file
 from primitives.env import PRIMITIVES
 from primitives.frames import FrameSearch
 from primitives.success import WEIGHTS_DIR
@@ -69,9 +68,11 @@ def read_info(path: Path) -> dict:
     if path.suffix == ".json":
         return dict(FrameSearch.load(path).info)
     try:
-        return dict(torch.load(path, map_location="cpu", weights_only=False).get("info", {}))
-    except Exception as exc:
-        raise InputError(f"{path} cannot be read ({type(exc).__name__}: {exc})") from exc
+        content = weights_file.read(path)
+    except WeightsError as exc:
+        raise InputError(f"{path} cannot be read ({exc})") from exc
+    payload = content.get("payload", content) if isinstance(content, dict) else {}
+    return dict(payload.get("info", {})) if isinstance(payload, dict) else {}
 
 
 @dataclass
@@ -172,9 +173,9 @@ def relabel(path: Path, release: str, digests: dict[str, str]) -> None:
         search = FrameSearch.load(path)
         replace(search, info=update(dict(search.info))).save(path)
     else:
-        state = torch.load(path, map_location="cpu", weights_only=False)
-        state["info"] = update(dict(state.get("info", {})))
-        torch.save(state, path)
+        content = weights_file.read(path)
+        content["payload"]["info"] = update(dict(content["payload"].get("info", {})))
+        weights_file.save(path, content["payload"], content["meta"])
 
 
 def ship(plan: ShipPlan, release: str) -> None:

@@ -53,6 +53,8 @@ class Skill:
                  searched_weights: str | os.PathLike | None = None):
         self.name = name
         self.model = model
+        # The clouds the policy was trained on (its weights' metadata): what a simulator should show it.
+        self.sensor: str = getattr(model, "sensor", "cameras")
         self.n_points = n_points
         self._success_weights = success_weights
         self._success: SuccessModel | None = None
@@ -221,3 +223,10 @@ def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[str, Skill
         InputError: ``weights_dir`` is not a folder, or a policy in it has no success model beside it.
     """
     return {name: load_skill(name, weights_dir=weights_dir) for name in PRIMITIVES}
+
+
+def skills_sensor(skills: dict[str, Skill]) -> str:
+    """The sensor a simulator should give ``skills`` (:attr:`Skill.sensor`): the one they were all trained on;
+    ``"cameras"`` (the default sensor) when they disagree."""
+    sensors = {skill.sensor for skill in skills.values()}
+    return sensors.pop() if len(sensors) == 1 else "cameras"

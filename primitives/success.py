@@ -685,10 +685,14 @@ def _platt(z: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
 
 
 # ------------------------------------------------------------------------ save and load
-def save(net: SuccessNet, path: str | os.PathLike, info: dict, sensor: str | None = None) -> None:
-    """Write a success net in the safe weights format (:mod:`primitives.weights_file`); ``info["skill"]`` names its
-    skill."""
-    meta = weights_file.make_meta(info["skill"], "success", sensor=sensor or info.get("sensor", "surface"))
+def save(net: SuccessNet, path: str | os.PathLike, info: dict, skill: str | None = None,
+         sensor: str | None = None) -> None:
+    """Write a success net in the safe weights format (:mod:`primitives.weights_file`), for ``skill`` (default:
+    ``info["skill"]``) and the clouds of ``sensor`` (default: ``info["sensor"]``, else the depth cameras)."""
+    skill = skill or info.get("skill")
+    if skill not in PRIMITIVES:
+        raise InputError(f"a success model is saved for a skill in {PRIMITIVES}, got {str(skill)[:40]}")
+    meta = weights_file.make_meta(skill, "success", sensor=sensor or info.get("sensor", "cameras"))
     weights_file.save(Path(path), dict(model=net.state_dict(), info=info), meta)
 
 

@@ -307,7 +307,7 @@ def _train_locked(cfg: TrainConfig, out: Path, resume: bool, progress: bool) -> 
               file=sys.stderr)
         resume = False
     elif resume:
-        saved = ckpt.load(ckpt_path, skill=cfg.primitive)
+        saved = ckpt.load(ckpt_path)  # any skill: check_resume names what differs
         check_resume(saved.get("config", {}), cfg, ckpt_path)
         model.load_state_dict(saved["model"])
         opt_critic.load_state_dict(saved["opt_critic"])
@@ -570,6 +570,7 @@ def main(argv: list[str] | None = None) -> int:
     except (InputError, ImportError) as exc:
         parser.error(str(exc))
     signal.signal(signal.SIGTERM, _raise_interrupt)  # a polite kill stops like Ctrl-C: checkpoint, then exit
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # also when started in the background (SIG_IGN)
     try:
         summary = train(cfg, resume=args.resume)
     except (InputError, ckpt.CheckpointError) as exc:  # one line, not a traceback

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import pickle
 import sys
 import tempfile
 from collections.abc import Mapping
@@ -36,6 +35,7 @@ FORMAT = "affordplan-weights"
 FORMAT_VERSION = 1
 KINDS = ("policy", "success", "checkpoint")
 SKILLS = ("push", "roll", "spin")
+_WHAT = {"policy": "weights", "success": "success model", "checkpoint": "checkpoint"}  # for messages
 SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one place that knows where they live
 
 
@@ -86,7 +86,7 @@ def save(path: str | os.PathLike, payload: Mapping, meta: Mapping) -> None:
         raise
 
 
-def read(path: str | os.PathLike) -> Any:
+def read(path: str | os.PathLike, what: str = "weights") -> Any:
     """Whatever ``path`` holds, through torch's restricted unpickler (tensors and plain containers only).
 
     Raises:
@@ -94,18 +94,18 @@ def read(path: str | os.PathLike) -> Any:
     """
     path = Path(path)
     if not path.exists():
-        raise WeightsError(f"no weights file at {path}")
+        raise WeightsError(f"no {what} at {path}")
     if path.is_dir():
-        raise WeightsError(f"{path} is a folder, not a weights file")
+        raise WeightsError(f"{path} is a folder, not a {what} file")
     try:
         return torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # torch raises several types; UnpicklingError for anything beyond tensors
         text = str(exc).strip().splitlines()
         first = text[0][:200] if text else type(exc).__name__
-        if "Weights only load failed" in str(exc) or isinstance(exc, pickle.UnpicklingError):
+        if "Unsupported global" in str(exc) or "GLOBAL" in str(exc):  # an object torch would have to construct
             raise WeightsError(f"{path} is not a safe weights file: it holds objects other than tensors and plain "
                                f"values (loading it could run code), so it was not loaded ({first})") from exc
-        raise WeightsError(f"{path} is damaged or truncated ({type(exc).__name__}: {first})") from exc
+        raise WeightsError(f"{what} {path} is damaged or truncated ({type(exc).__name__}: {first})") from exc
 
 
 def load(path: str | os.PathLike, *, kind: str, skill: str | None = None) -> tuple[dict, dict]:
@@ -114,7 +114,7 @@ def load(path: str | os.PathLike, *, kind: str, skill: str | None = None) -> tup
     Raises:
         WeightsError: see :func:`read`; no affordplan metadata; another kind, skill or format version.
     """
-    content = read(path)
+    content = read(path, _WHAT.get(kind, kind))
     meta = content.get("meta") if isinstance(content, dict) else None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT or not isinstance(content.get("payload"), dict):
         raise WeightsError(f"{path} carries no affordplan weights metadata (written by an older release or another "

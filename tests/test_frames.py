@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 import affordplan as ap
 from affordplan.errors import InputError
 from primitives import params as skill_params
-from primitives import rewards
+from primitives import rewards, weights_file
 from primitives.env import observation, observe_cloud, skill_observation
 from primitives.frames import (
     MIRROR_Y,
@@ -199,12 +199,12 @@ def test_the_shipped_skills_search_the_frames_shipped_beside_them(name):
 
 
 def test_given_weights_get_no_shipped_frame_search(tmp_path):
-    import torch
 
     from primitives import load_skill
     from primitives.networks import HybridActorCritic
 
-    torch.save(HybridActorCritic().state_dict(), tmp_path / "w.pt")
+    weights_file.save(tmp_path / "w.pt", dict(model=HybridActorCritic().state_dict()),
+                      weights_file.make_meta("spin", "policy"))
     assert load_skill("spin", weights=tmp_path / "w.pt").frame_search is None  # the shipped calibration is not theirs
     search = FrameSearch(4, False)
     assert load_skill("spin", weights=tmp_path / "w.pt", frame_search=search).frame_search == search
@@ -223,7 +223,7 @@ def test_a_searched_success_model_rates_the_searched_skill_from_the_goal_frame(t
             member.head[-1].weight.zero_()
             member.head[-1].bias.zero_()
         net.platt.copy_(torch.tensor([1.0, 2.0]))
-    success.save(net, tmp_path / "searched.pt", {})
+    success.save(net, tmp_path / "searched.pt", {}, skill="spin")
     shipped = load_skill("spin", searched=False)
     skill = Skill("spin", shipped.model, frame_search=shipped_frame_search("spin"),
                   searched_weights=tmp_path / "searched.pt")
@@ -246,14 +246,13 @@ def test_a_searched_success_model_rates_the_searched_skill_from_the_goal_frame(t
 
 @pytest.mark.parametrize("name", ["push", "roll", "spin"])
 def test_the_shipped_skills_rate_with_their_shipped_searched_success_model(name):
-    import torch
 
     from primitives import load_skill
     from primitives.success import WEIGHTS_DIR, load_success_net
 
     skill = load_skill(name)
     assert skill.searched_model is not None
-    info = torch.load(WEIGHTS_DIR / f"{name}_success_searched.pt", weights_only=False)["info"]
+    info = weights_file.load(WEIGHTS_DIR / f"{name}_success_searched.pt", kind="success")[0]["info"]
     assert info["frames"] == "shipped" and f"train {name}" in info["command"]
     assert load_success_net(name, WEIGHTS_DIR / f"{name}_success_searched.pt").members
     assert load_skill(name, searched=False).searched_model is None

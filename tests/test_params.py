@@ -132,7 +132,7 @@ def test_goal_frame_motion_reaches_the_world():
     """A goal-frame push along +x, from the point the frame puts last along x, moves the cube along the direction."""
     from primitives.env import skill_observation
 
-    sim = ap.Simulator(ap.load_object("cube"), seed=0)
+    sim = ap.Simulator(ap.load_object("cube"), seed=0, sensor="surface")  # frames, not sensing, are tested here
     sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
     seen = skill_observation(sim, "push", {"direction": math.pi / 2}, 256)
     assert np.allclose(seen.obs[:, 6:9], [0.05, 0.0, 0.0], atol=1e-6)  # the flow is "+x" for every point

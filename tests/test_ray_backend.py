@@ -15,6 +15,7 @@ import pytest
 import torch
 
 from primitives import checkpoint as ckpt
+from primitives import weights_file
 from primitives.compare_backends import Proportions
 from primitives.env import EnvConfig
 from primitives.networks import HybridActorCritic
@@ -32,13 +33,14 @@ def _quiet_ray(monkeypatch):
 def test_cli_ray_run_writes_checkpoint_and_policy(tmp_path):
     """`python -m primitives.train push --backend ray --steps 64 --workers 1 --out DIR`, in-process."""
     was_running = ray.is_initialized()
-    assert main(["push", "--backend", "ray", "--steps", "64", "--workers", "1", "--out", str(tmp_path)]) == 0
+    assert main(["push", "--backend", "ray", "--steps", "64", "--workers", "1", "--learning-starts", "16",
+                 "--out", str(tmp_path)]) == 0
     assert ray.is_initialized() == was_running  # the instance it started is shut down again
     saved = ckpt.load(tmp_path / "checkpoint.pt")
     assert saved["state"]["global_step"] == 64  # exactly the budget: surplus transitions are dropped
     assert saved["replay"]["size"] == 64 - saved["state"]["invalid"] > 0
     assert np.isfinite(saved["replay"]["reward"]).all()
-    policy = torch.load(tmp_path / "policy.pt")
+    policy = weights_file.load(tmp_path / "policy.pt", kind="policy", skill="push")[0]["model"]
     assert all(torch.equal(saved["model"][k], v) for k, v in policy.items())
     config = json.loads((tmp_path / "config.json").read_text())
     assert config["backend"] == "ray" and config["workers"] == 1 and config["ray_address"] is None

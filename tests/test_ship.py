@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from affordplan.errors import InputError
-from primitives import load_skill
+from primitives import load_skill, weights_file
 from primitives.ship import main, plan_ship, ship
 from primitives.success import WEIGHTS_DIR
 
@@ -27,9 +27,9 @@ def set_info(path: Path, **values) -> None:
         data["info"].update(values)
         path.write_text(json.dumps(data))
     else:
-        state = torch.load(path, weights_only=False)
-        state["info"].update(values)
-        torch.save(state, path)
+        content = weights_file.read(path)
+        content["payload"]["info"].update(values)
+        weights_file.save(path, content["payload"], content["meta"])
 
 
 @pytest.fixture
@@ -69,11 +69,11 @@ def test_shipping_keeps_the_old_files_and_relabels_the_new(layout):
     assert digest(weights / "push.pt") == digest(cand / "push.pt")  # the policy is copied as it is
     assert (weights / "push.eval_seed7.json").read_bytes() == (cand / "push.eval_seed7.json").read_bytes()
 
-    searched = torch.load(weights / "push_success_searched.pt", weights_only=False)
+    searched = weights_file.read(weights / "push_success_searched.pt")["payload"]
     info = searched["info"]
     assert info["policy"] == info["model"] == info["frames"] == "shipped"
     assert info["trained_with"] == runs and "9.9.9" in info["note"] and digest(cand / "push.pt")[:12] in info["note"]
-    source = torch.load(cand / "push_success_searched.pt", weights_only=False)
+    source = weights_file.read(cand / "push_success_searched.pt")["payload"]
     assert all(torch.equal(searched["model"][k], source["model"][k]) for k in source["model"])  # weights untouched
     frames = json.loads((weights / "push_frames.json").read_text())
     assert frames["info"]["trained_with"] == {"policy": runs["policy"], "model": runs["model"]}

@@ -10,6 +10,7 @@ import pytest
 import torch
 
 from primitives import checkpoint as ckpt
+from primitives import weights_file
 from primitives.env import EnvConfig, PrimitiveEnv
 from primitives.evaluate import evaluate, greedy_action, load_policy
 from primitives.networks import HybridActorCritic, choose_contact
@@ -125,7 +126,7 @@ def _cube_config(out, steps: int) -> TrainConfig:
 def test_checkpoint_resume_round_trips(tmp_path):
     summary = train(_cube_config(tmp_path, 120), progress=False)
     saved = ckpt.load(tmp_path / "checkpoint.pt")
-    policy = torch.load(tmp_path / "policy.pt")
+    policy = weights_file.load(tmp_path / "policy.pt", kind="policy", skill="push")[0]["model"]
     assert all(torch.equal(saved["model"][k], v) for k, v in policy.items())
     assert saved["state"]["global_step"] == summary["steps"] == 120
     replay = ReplayBuffer(1000, 128)
@@ -150,8 +151,8 @@ def test_resume_lets_go_of_the_loaded_checkpoint(tmp_path, monkeypatch):
     train(_cube_config(tmp_path, 120), progress=False)
     held, load = [], ckpt.load
 
-    def load_and_watch(path):
-        saved = load(path)
+    def load_and_watch(path, **kwargs):
+        saved = load(path, **kwargs)
         held.append(weakref.ref(saved["replay"]["obs"]))
         return saved
 
@@ -246,7 +247,8 @@ def test_skill_acts_and_judges_with_given_weights(tmp_path):
     from primitives import load_skill
 
     torch.manual_seed(0)
-    torch.save(HybridActorCritic().state_dict(), tmp_path / "w.pt")
+    weights_file.save(tmp_path / "w.pt", dict(model=HybridActorCritic().state_dict()),
+                      weights_file.make_meta("push", "policy"))
     skill = load_skill("push", weights=tmp_path / "w.pt")
     sim = ap.Simulator(ap.load_object("cube"))
     sim.reset()
@@ -335,4 +337,5 @@ def test_resume_without_a_checkpoint_says_it_starts_a_new_run(tmp_path, capsys):
                       replay_size=64, checkpoint_minutes=60.0)
     summary = train(cfg, resume=True, progress=False)
     assert summary["steps"] == 2 and (tmp_path / "checkpoint.pt").exists()
-    assert f"no checkpoint in {tmp_path} to resume from: starting a new run there" in capsys.readouterr().err
+    assert f"no checkpoint in {tmp_path} yet (the run stopped before its first): starting it again from step 0" \
+        in capsys.readouterr().err

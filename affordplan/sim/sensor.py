@@ -45,6 +45,8 @@ class DepthCamera:
         forward = np.subtract(self.target, self.position, dtype=float)
         forward /= np.linalg.norm(forward)
         right = np.cross(forward, [0.0, 0.0, 1.0])
+        if np.linalg.norm(right) < 1e-9:  # looking straight down (or up): image up is world +x
+            right = np.cross(forward, [1.0, 0.0, 0.0])
         right /= np.linalg.norm(right)
         up = np.cross(right, forward)
         half_h = math.tan(self.fovy / 2)
@@ -150,6 +152,19 @@ class CameraSensor:
         idx = rng.choice(len(points), size=n, replace=len(points) < n)
         normals = estimate_normals(points, np.asarray(self._origins)[seen_by[idx]], at=idx)
         return points[idx], normals
+
+
+def surface_cloud(samples_obj: np.ndarray, normals_obj: np.ndarray, T_world_object: np.ndarray,
+                  rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The privileged sensor (``sensor="surface"``): ``n`` of an object's even surface samples (object frame) and
+    their exact normals, posed at ``T_world_object``; points touching the table are left out (unless all do)."""
+    points = np.asarray(samples_obj) @ T_world_object[:3, :3].T + T_world_object[:3, 3]
+    normals = np.asarray(normals_obj) @ T_world_object[:3, :3].T
+    visible = np.flatnonzero(points[:, 2] > TABLE_CONTACT_HEIGHT)
+    if len(visible) == 0:
+        visible = np.arange(len(points))
+    idx = rng.choice(visible, size=n, replace=len(visible) < n)
+    return points[idx], normals[idx]
 
 
 def estimate_normals(points: np.ndarray, viewpoints: np.ndarray, k: int = NORMAL_NEIGHBOURS,

@@ -29,7 +29,7 @@ from affordplan.sim.arm import HOME, ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
 from affordplan.sim.pushers import ArmPusher, FingerPusher
 from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf
-from affordplan.sim.sensor import SENSORS, TABLE_CONTACT_HEIGHT, CameraSensor
+from affordplan.sim.sensor import SENSORS, TABLE_CONTACT_HEIGHT, CameraSensor, surface_cloud
 from affordplan.world import Box, Workspace
 
 MAX_CLOUD_POINTS = 100_000  # most points one cloud may ask for
@@ -256,14 +256,7 @@ class Simulator:
             if len(points) == 0:
                 raise PerceptionError("no camera sees the object (hidden behind obstacles or the arm)")
             return points, normals
-        T = self.object_pose()
-        points = transform_points(T, self._samples_obj)
-        normals = self._normals_obj @ T[:3, :3].T
-        visible = np.flatnonzero(points[:, 2] > TABLE_CONTACT_HEIGHT)
-        if len(visible) == 0:
-            visible = np.arange(len(points))
-        idx = self._rng.choice(visible, size=n, replace=len(visible) < n)
-        return points[idx], normals[idx]
+        return surface_cloud(self._samples_obj, self._normals_obj, self.object_pose(), self._rng, int(n))
 
     def surface_normal(self, point_world: np.ndarray) -> np.ndarray:
         """Outward normal (world frame) of the surface sample nearest to ``point_world``."""
