@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import textwrap
 
@@ -84,9 +85,12 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 def _cmd_render(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from affordplan.errors import InputError
     from affordplan.objects.model import load_object
     from affordplan.render import render_states, save_states_picture, state_label
 
+    if args.out is not None and Path(args.out).suffix.lower() not in (".png", ".jpg", ".jpeg"):
+        raise InputError(f"--out {args.out[:80]}: the picture is written as .png or .jpg")
     obj = load_object(args.object, size=args.size)
     print(f"{obj.name}: {len(obj.resting_states)} resting states (most likely first)")
     for s in obj.resting_states:
@@ -174,9 +178,10 @@ def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_pr
                    help="the planner, or the reactive greedy baseline (default: %(default)s)")
     p.add_argument("--max-primitives", type=_positive_int, default=max_primitives, metavar="N",
                    help="stop executing after N skill calls (default: %(default)s)")
-    p.add_argument("--time-limit", type=float, default=5.0, metavar="S",
+    p.add_argument("--time-limit", type=_bounded_float(0.0, 600.0, "seconds"), default=5.0, metavar="S",
                    help="seconds per planning call (default: %(default)s)")
-    p.add_argument("--seed", type=int, default=0, help="seeds the planner and the point clouds (default: %(default)s)")
+    p.add_argument("--seed", type=_seed, default=0,
+                   help="seeds the planner and the point clouds (default: %(default)s)")
     p.add_argument("--weights-dir", default=None, metavar="DIR",
                    help="run the skills from this folder's files (laid out like primitives/weights/, e.g. a "
                         "candidate set under primitives/weights/candidates/) instead of the shipped ones")
@@ -186,10 +191,13 @@ def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_pr
     video.add_argument("--camera", default=None, choices=["arm", "overview", "wide", "top"],
                        help="arm: the whole arm; overview: closer on the object (default: arm with --sim arm, "
                             "overview with --sim finger)")
-    video.add_argument("--width", type=_positive_int, default=480, help="frame width, pixels (default: %(default)s)")
-    video.add_argument("--height", type=_positive_int, default=360, help="frame height, pixels (default: %(default)s)")
-    video.add_argument("--fps", type=float, default=10.0, help="video frame rate (default: %(default)s)")
-    video.add_argument("--frame-interval", type=float, default=0.25, metavar="S",
+    video.add_argument("--width", type=_pixels(MAX_WIDTH), default=480,
+                       help="frame width, pixels (default: %(default)s)")
+    video.add_argument("--height", type=_pixels(MAX_HEIGHT), default=360,
+                       help="frame height, pixels (default: %(default)s)")
+    video.add_argument("--fps", type=_bounded_float(0.0, 240.0, "frames per second"), default=10.0,
+                       help="video frame rate (default: %(default)s)")
+    video.add_argument("--frame-interval", type=_bounded_float(0.0, 10.0, "seconds"), default=0.25, metavar="S",
                        help="simulated seconds between frames (default: %(default)s)")
     p.add_argument("--viewer", action="store_true",
                    help="also show MuJoCo's interactive viewer (needs a display; on macOS run under mjpython)")
@@ -207,8 +215,44 @@ def _int_at_least(text: str, low: int, what: str) -> int:
     return value
 
 
+def _seed(text: str) -> int:
+    """A random seed: a whole number in [0, 2**32)."""
+    value = _int_at_least(text, 0, "non-negative")
+    if value >= 2**32:
+        raise argparse.ArgumentTypeError(f"a seed is below 2**32, got {text[:40]}")
+    return value
+
+
+def _bounded_float(low: float, high: float, what: str):
+    """An argparse type: a finite number in (``low``, ``high``]."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number ({what}), got {text[:40]!r}") from None
+        if not math.isfinite(value) or not low < value <= high:
+            raise argparse.ArgumentTypeError(f"{what} must be in ({low:g}, {high:g}], got {text[:40]}")
+        return value
+
+    return parse
+
+
 def _positive_int(text: str) -> int:
     return _int_at_least(text, 1, "positive")
+
+
+MAX_WIDTH, MAX_HEIGHT = 1280, 960  # the scene's offscreen buffer (affordplan.sim.scene)
+
+
+def _pixels(most: int):
+    """An argparse type: a whole number of pixels in [1, ``most``]."""
+    def parse(text: str) -> int:
+        value = _int_at_least(text, 1, "positive")
+        if value > most:
+            raise argparse.ArgumentTypeError(f"at most {most} pixels, got {text[:40]}")
+        return value
+
+    return parse
 
 
 def _nonnegative_int(text: str) -> int:
@@ -303,9 +347,12 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--state", type=int, nargs="+", default=None, metavar="S",
                         help="resting-state indices to render (default: all)")
     render.add_argument("--out", default=None, metavar="PNG", help="picture to write (default: <object>_states.png)")
-    render.add_argument("--size", type=float, default=0.05, help="largest half-extent, metres (default: %(default)s)")
-    render.add_argument("--width", type=_positive_int, default=320, help="tile width, pixels (default: %(default)s)")
-    render.add_argument("--height", type=_positive_int, default=240, help="tile height, pixels (default: %(default)s)")
+    render.add_argument("--size", type=_bounded_float(0.0, 1.0, "metres"), default=0.05,
+                        help="largest half-extent, metres (default: %(default)s)")
+    render.add_argument("--width", type=_pixels(MAX_WIDTH), default=320,
+                        help="tile width, pixels (default: %(default)s)")
+    render.add_argument("--height", type=_pixels(MAX_HEIGHT), default=240,
+                        help="tile height, pixels (default: %(default)s)")
     render.set_defaults(func=_cmd_render)
 
     aff = sub.add_parser(
@@ -318,9 +365,9 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=_formatter,
     )
     aff.add_argument("object", help="catalogue name or mesh path")
-    aff.add_argument("--trials", type=int, default=10, help="starts per action (default: %(default)s)")
-    aff.add_argument("--sectors", type=int, default=8, help="push direction sectors (default: %(default)s)")
-    aff.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    aff.add_argument("--trials", type=_positive_int, default=10, help="starts per action (default: %(default)s)")
+    aff.add_argument("--sectors", type=_positive_int, default=8, help="push direction sectors (default: %(default)s)")
+    aff.add_argument("--seed", type=_seed, default=0, help="random seed (default: %(default)s)")
     aff.add_argument("--plot", default=None, help="write a bar chart per resting state here")
     aff.add_argument("--json", action="store_true", help="print JSON instead of a table")
     aff.set_defaults(func=_cmd_affordances)
@@ -347,7 +394,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     sim.add_argument("-n", type=_positive_int, default=500, help="primitives per object (default: %(default)s)")
     sim.add_argument("--pusher", default="finger", choices=["finger", "arm"], help="pusher (default: finger)")
-    sim.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    sim.add_argument("--seed", type=_seed, default=0, help="random seed (default: %(default)s)")
     sim.add_argument("--json", action="store_true", help="print JSON instead of a report")
     sim.set_defaults(func=_cmd_bench_sim)
 
@@ -363,7 +410,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s2s.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     s2s.add_argument("-n", type=_positive_int, default=100, help="primitives per object (default: %(default)s)")
-    s2s.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    s2s.add_argument("--seed", type=_seed, default=0, help="random seed (default: %(default)s)")
     s2s.add_argument("--skill", nargs="+", choices=["push", "roll", "spin"],
                      help="compare the shipped skills' success instead (on held-out objects; -n draws each)")
     s2s.set_defaults(func=_cmd_bench_sim2sim)
@@ -384,7 +431,7 @@ def build_parser() -> argparse.ArgumentParser:
     bq.add_argument("--rounds", type=_positive_int, default=10,
                     help="interleave the skills' timings over this many rounds, so that a machine's drift falls on "
                          "all of them alike (default: %(default)s)")
-    bq.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    bq.add_argument("--seed", type=_seed, default=0, help="random seed (default: %(default)s)")
     bq.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bq.add_argument("--weights-dir", default=None, metavar="DIR",
                     help="time the skills of this folder's files (laid out like primitives/weights/, e.g. a "
@@ -405,10 +452,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bp.add_argument("--tasks", type=_positive_int, default=50, help="number of tasks (default: %(default)s)")
     bp.add_argument("--sim", default="arm", choices=["arm", "finger"], help="pusher (default: arm)")
-    bp.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    bp.add_argument("--seed", type=_seed, default=0, help="random seed (default: %(default)s)")
     bp.add_argument("--planner", nargs="+", default=["affordplan", "greedy"], choices=["affordplan", "greedy"],
                     help="planners to compare (default: both)")
-    bp.add_argument("--max-primitives", type=int, default=40, help="per task (default: %(default)s)")
+    bp.add_argument("--max-primitives", type=_positive_int, default=40, help="per task (default: %(default)s)")
     bp.add_argument("--task", type=_nonnegative_int, nargs="+", default=None, metavar="I",
                     help="run only these tasks of the seed's draw (the same tasks as in the whole run)")
     bp.add_argument("--log", action="store_true",

@@ -178,7 +178,12 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
         raise InputError(f"fps must be positive, got {fps!r}")
     t_start = time.perf_counter()
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {str(out)[:120]} is a file, not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot create the output folder {str(out)[:120]} ({exc.strerror})") from None
     echo(f"scene {scene.name}: {scene.description}" if scene.description else f"scene {scene.name}")
     obj = scene.load_object()
     echo(f"object: {obj.name}; resting states: " + ", ".join(
@@ -251,10 +256,15 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
 
 def _write_outputs(run: SceneRun, obj: ObjectModel, out: Path, recorder: FrameRecorder | None,
                    keyframes: list[tuple[str, np.ndarray]], fps: float, t_start: float) -> None:
-    """plan.png, frames.png and the video (when frames were rendered), summary.json; fills ``run.files``."""
+    """summary.json, then plan.png, frames.png and the video (when frames were rendered), then summary.json again
+    with every file and the whole time; fills ``run.files``."""
     from planner.plot import plot_plan
 
     ex = run.execution
+    # The results first: whatever goes wrong with the pictures or the video, summary.json is on disk.
+    run.files["summary"] = out / "summary.json"
+    run.wall_time = time.perf_counter() - t_start
+    run.files["summary"].write_text(json.dumps(summary(run, obj), indent=2) + "\n", encoding="utf-8")
     run.files["plan"] = out / "plan.png"
     plot_plan(run.plan, run.files["plan"], execution=ex,
               title=f"{run.scene.name}: {obj.name}, {'goal reached' if ex.success else 'goal NOT reached'} "

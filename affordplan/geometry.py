@@ -32,7 +32,10 @@ def rot_z(yaw: float) -> np.ndarray:
 
 def check_pose(T: np.ndarray, name: str = "pose") -> np.ndarray:
     """Return ``T`` as a float 4x4 array, or raise :class:`InputError` if it is malformed."""
-    T = np.asarray(T, dtype=float)
+    try:
+        T = np.asarray(T, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{name} must be a 4x4 homogeneous matrix of numbers") from None
     if T.shape != (4, 4):
         raise InputError(f"{name} must be a 4x4 homogeneous matrix, got shape {T.shape}")
     if not np.all(np.isfinite(T)):

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from affordplan.checks import is_whole
-from affordplan.errors import GoalError
+from affordplan.checks import as_finite, as_vector, as_whole, describe
+from affordplan.errors import GoalError, InputError
 from affordplan.geometry import wrap_period
 from affordplan.objects.model import ObjectModel
 
@@ -40,25 +40,23 @@ class Goal:
 
     def __post_init__(self):
         try:
-            xy = np.asarray(self.xy, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise GoalError(f"goal xy must be two finite numbers (metres), got {self.xy!r}") from None
-        if xy.shape != (2,) or not np.all(np.isfinite(xy)):
-            raise GoalError(f"goal xy must be two finite numbers (metres), got {self.xy!r}")
-        object.__setattr__(self, "xy", (float(xy[0]), float(xy[1])))
-        if self.yaw is not None:
-            if not isinstance(self.yaw, (int, float, np.floating)) or not math.isfinite(self.yaw):
-                raise GoalError(f"goal yaw must be a finite angle in radians or None, got {self.yaw!r}")
-            object.__setattr__(self, "yaw", float(self.yaw))
-        if self.resting_state is not None and not is_whole(self.resting_state):
-            raise GoalError(f"goal resting_state must be an integer index or None, got {self.resting_state!r}")
+            xy = as_vector("goal xy (metres)", self.xy, 2)
+            yaw = None if self.yaw is None else as_finite("goal yaw (radians)", self.yaw)
+            state = None if self.resting_state is None else as_whole("goal resting_state", self.resting_state)
+            tolerances = [as_finite(f"goal {name}", getattr(self, name)) for name in ("xy_tol", "yaw_tol")]
+        except InputError as exc:
+            raise GoalError(str(exc)) from None
         if not isinstance(self.yaw_symmetric, (bool, np.bool_)):
-            raise GoalError(f"goal yaw_symmetric must be True or False, got {self.yaw_symmetric!r}")
-        object.__setattr__(self, "yaw_symmetric", bool(self.yaw_symmetric))
-        for name in ("xy_tol", "yaw_tol"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, float, np.floating)) or not math.isfinite(v) or v <= 0:
+            raise GoalError(f"goal yaw_symmetric must be True or False, got {describe(self.yaw_symmetric)}")
+        for name, v in zip(("xy_tol", "yaw_tol"), tolerances):
+            if v <= 0:
                 raise GoalError(f"goal {name} must be a positive number, got {v!r}")
+        object.__setattr__(self, "xy", (float(xy[0]), float(xy[1])))
+        object.__setattr__(self, "yaw", yaw)
+        object.__setattr__(self, "resting_state", state)
+        object.__setattr__(self, "yaw_symmetric", bool(self.yaw_symmetric))
+        object.__setattr__(self, "xy_tol", tolerances[0])
+        object.__setattr__(self, "yaw_tol", tolerances[1])
 
     def check_object(self, obj: ObjectModel) -> None:
         """Raise :class:`GoalError` when the resting state does not exist for ``obj``."""

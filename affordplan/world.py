@@ -11,14 +11,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordplan.checks import as_vector
 from affordplan.errors import InputError
+
+WORLD_BOUND = 10.0  # metres: no coordinate or length of the table-top world is larger
 
 
 def _finite(values, name: str, n: int) -> tuple[float, ...]:
-    arr = np.asarray(values, dtype=float).reshape(-1)
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} must be {n} finite numbers, got {values!r}")
-    return tuple(float(v) for v in arr)
+    return tuple(float(v) for v in as_vector(name, values, n, WORLD_BOUND))
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from affordplan.checks import is_whole
+from affordplan.checks import as_finite, as_vector, as_whole
 from affordplan.errors import GoalError, InputError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
@@ -20,6 +20,10 @@ from planner.predict import Predictor
 PLANNERS = ("affordplan", "greedy")
 
 
+START_TILT_MAX = math.radians(10.0)  # a start pose is this close to one of its resting states, or refused
+START_HEIGHT_MAX = 0.01  # metres off the state's resting height (a pose floating above the table is refused)
+
+
 def start_pose(obj: ObjectModel, start) -> np.ndarray:
     """The 4x4 world pose of ``start``: a dict ``{"resting_state", "xy", "yaw"}`` or a 4x4 pose."""
     if start is None:
@@ -28,18 +32,14 @@ def start_pose(obj: ObjectModel, start) -> np.ndarray:
         unknown = set(start) - {"resting_state", "xy", "yaw"}
         if unknown:
             raise InputError(f"start takes resting_state, xy and yaw; got {sorted(unknown)}")
-        state = start.get("resting_state", 0)
+        state = as_whole("start resting_state", start.get("resting_state", 0))
         n = len(obj.resting_states)
-        if not is_whole(state):
-            raise InputError(f"start resting_state must be an integer index, got {state!r}")
         if not 0 <= state < n:
             raise GoalError(f"start resting_state {state} does not exist: {obj.name} has {n} resting states "
                             f"(0..{n - 1})")
-        xy = np.asarray(start.get("xy", Workspace().center), dtype=float)
-        yaw = start.get("yaw", 0.0)
-        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not math.isfinite(yaw):
-            raise InputError(f"start xy must be 2 finite numbers and yaw finite, got {start!r}")
-        return obj.resting_states[int(state)].pose(xy, float(yaw))
+        xy = as_vector("start xy (metres)", start.get("xy", Workspace().center), 2)
+        yaw = as_finite("start yaw (radians)", start.get("yaw", 0.0))
+        return obj.resting_states[state].pose(xy, yaw)
     try:
         T = np.asarray(start, dtype=float)
     except (TypeError, ValueError):
@@ -60,6 +60,14 @@ def check_start(obj: ObjectModel, T_start: np.ndarray, obstacles: Sequence[Box],
     start closer to an obstacle than that clearance is legal (the plan then pushes it clear first).
     """
     state, x, y, yaw = obj.planar_pose(T_start)
+    tilt = obj.tilt_from_state(T_start, state)
+    if tilt > START_TILT_MAX:
+        raise GoalError(f"the start pose is tipped {math.degrees(tilt):.0f} deg from every resting state; a start "
+                        f"must rest on the table (at most {math.degrees(START_TILT_MAX):.0f} deg off)")
+    height = float(T_start[2, 3]) - obj.resting_states[state].height
+    if abs(height) > START_HEIGHT_MAX:
+        raise GoalError(f"the start pose is {100 * height:+.1f} cm off the table's contact height; a start must rest "
+                        f"on the table (within {100 * START_HEIGHT_MAX:.0f} cm)")
     if not workspace.contains((x, y)):
         raise GoalError(f"the start xy=({x:.3f}, {y:.3f}) is outside the workspace {workspace}")
     m = WORKSPACE_OVERHANG

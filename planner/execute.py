@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from affordplan.errors import AffordplanError
+from affordplan.errors import AffordplanError, InputError
 from affordplan.geometry import wrap_angle, wrap_period
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
@@ -98,12 +98,24 @@ def _simulator(sim, obj: ObjectModel, obstacles, T_start: np.ndarray, seed: int,
     """``sim`` itself, or a new ``"arm"`` / ``"finger"`` simulator that shows the skills ``sensor``'s clouds (the
     sensor their weights were trained on, :func:`primitives.skills.skills_sensor`)."""
     if isinstance(sim, Simulator):
+        _check_same_world(sim, obj, obstacles)
         return sim
     if sim not in ("arm", "finger"):
         raise AffordplanError(f"sim must be 'arm', 'finger' or a Simulator, got {sim!r}")
     s = Simulator(obj, obstacles=obstacles, pusher=sim, seed=seed, sensor=sensor)
     s.set_object_pose(T_start)
     return s
+
+
+def _check_same_world(sim: Simulator, obj: ObjectModel, obstacles) -> None:
+    """Raise :class:`InputError` unless ``sim`` holds the plan's object and obstacles: a plan executed in another
+    world would label poses with the wrong resting states, or walk into a wall it never saw."""
+    if sim.obj is not obj and (sim.obj.name != obj.name or len(sim.obj.mesh.vertices) != len(obj.mesh.vertices)
+                               or not np.allclose(sim.obj.mesh.vertices, obj.mesh.vertices)):
+        raise InputError(f"the simulator holds {sim.obj.name!r:.60}, the plan is for {obj.name!r:.60}")
+    if tuple(sim.obstacles) != tuple(obstacles):
+        raise InputError(f"the simulator has {len(sim.obstacles)} obstacles that differ from the plan's "
+                         f"{len(tuple(obstacles))}; plan with the simulator's obstacles (ap.plan(..., obstacles=...))")
 
 
 def _states(obj: ObjectModel, T_before: np.ndarray, T_after: np.ndarray | None = None) -> tuple[int, int]:

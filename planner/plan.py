@@ -667,8 +667,11 @@ class Plan:
 
     def execute(self, sim="arm", max_primitives: int = 60, render=None, seed: int = 0):
         """Run the plan closed-loop (see :mod:`planner.execute`); returns an ``Execution``."""
+        from affordplan.checks import as_whole
         from planner.execute import execute_greedy, execute_plan
 
+        max_primitives = as_whole("max_primitives", max_primitives, 1, 10_000)
+        seed = as_whole("seed", seed, 0, 2**32 - 1)
         if self.kind == "greedy":
             p = self.planner
             return execute_greedy(p.obj, self.goal, self.start_pose, p.predictor, sim=sim, obstacles=p.obstacles,

@@ -16,7 +16,6 @@ vertices, flat, zero volume) raises :class:`~affordplan.errors.MeshError` naming
 from __future__ import annotations
 
 import functools
-import math
 import os
 import warnings
 from pathlib import Path
@@ -24,7 +23,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from affordplan.errors import InputError, MeshError
+from affordplan.checks import as_finite
+from affordplan.errors import MeshError
 from affordplan.objects import decompose, family, housekeep, repair
 from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states, yaw_period
 from affordplan.objects.shapes import CATALOGUE, Shape
@@ -145,7 +145,12 @@ def _read_mesh(path: Path) -> trimesh.Trimesh:
     try:
         # process=False: trimesh's processing would silently drop NaN / infinite vertices;
         # repair.clean checks and processes the raw arrays.
-        loaded = trimesh.load(str(path), force="mesh", process=False)
+        scene = trimesh.load(str(path), process=False)
+        geometries = len(scene.geometry) if isinstance(scene, trimesh.Scene) else 1
+        if geometries > 1:
+            warnings.warn(f"{path.name} holds {geometries} meshes; they are merged into one rigid object",
+                          stacklevel=4)
+        loaded = scene.to_mesh() if isinstance(scene, trimesh.Scene) else scene
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise MeshError(f"cannot read mesh {path}: {repair.first_line(exc)}") from exc
     if not isinstance(loaded, trimesh.Trimesh):
@@ -169,10 +174,13 @@ def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float, density: float, wh
     return ObjectModel(name, probe.mesh, parts, probe.mass, probe.inertia)
 
 
+SIZE_RANGE = (0.005, 1.0)  # metres: the largest half-extent MuJoCo and the fingertip can handle
+DENSITY_RANGE = (1.0, 50_000.0)  # kg/m^3: foam to tungsten
+
+
 def _check_size(size: float, density: float) -> None:
-    for label, value in (("size", size), ("density", density)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise InputError(f"{label} must be a positive finite number, got {value!r}")
+    as_finite("size (metres)", size, *SIZE_RANGE)
+    as_finite("density (kg/m^3)", density, *DENSITY_RANGE)
 
 
 def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_DENSITY) -> ObjectModel:
@@ -200,6 +208,9 @@ def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_
         return _from_mesh("mesh", mesh, size, density, "scene")
     if isinstance(source, (str, os.PathLike)):
         text = os.fspath(source)
+        if not str(text).strip():
+            raise MeshError(f"empty object name; give a catalogue name ({', '.join(CATALOGUE)}), "
+                            "housekeep/NAME or a mesh file path")
         if text in CATALOGUE:
             return _from_shape(text, CATALOGUE[text](), size, density)
         if text.startswith(housekeep.PREFIX):

@@ -24,6 +24,7 @@ import trimesh
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from affordplan.errors import InputError
 from affordplan.geometry import rot_z, yaw_of_direction
 
 DEFAULT_MERGE_ANGLE = math.radians(25.0)
@@ -208,12 +209,18 @@ def yaw_period(vertices: np.ndarray, up: np.ndarray, max_order: int = MAX_SYMMET
 
 def classify(states: list[RestingState], R_world_object: np.ndarray) -> int:
     """Index of the state whose member up-vectors come closest to the pose's up-vector."""
-    up = np.asarray(R_world_object).T @ np.array([0.0, 0.0, 1.0])
+    R = np.asarray(R_world_object, dtype=float)
+    if R.shape != (3, 3) or not np.all(np.isfinite(R)):
+        raise InputError("classify takes a finite rotation (or 4x4 pose); it has NaN, infinite or misshapen entries")
+    up = R.T @ np.array([0.0, 0.0, 1.0])
     best = max(states, key=lambda s: float(np.max(s.member_ups @ up)))
     return best.index
 
 
 def angle_to_state(state: RestingState, R_world_object: np.ndarray) -> float:
     """Angle (radians) between a pose's up-vector and the nearest up-vector of ``state``."""
-    up = np.asarray(R_world_object).T @ np.array([0.0, 0.0, 1.0])
+    R = np.asarray(R_world_object, dtype=float)
+    if R.shape != (3, 3) or not np.all(np.isfinite(R)):
+        raise InputError("classify takes a finite rotation (or 4x4 pose); it has NaN, infinite or misshapen entries")
+    up = R.T @ np.array([0.0, 0.0, 1.0])
     return float(np.arccos(np.clip(np.max(state.member_ups @ up), -1.0, 1.0)))

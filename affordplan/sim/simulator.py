@@ -22,6 +22,7 @@ import mujoco
 import numpy as np
 from scipy.spatial import cKDTree
 
+from affordplan.checks import as_finite, as_seed, as_vector, as_whole, describe
 from affordplan.errors import InputError, PerceptionError, ReachabilityError
 from affordplan.geometry import check_pose, make_pose, relative_rotation, transform_points
 from affordplan.objects.model import ObjectModel
@@ -32,6 +33,8 @@ from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf
 from affordplan.sim.sensor import SENSORS, TABLE_CONTACT_HEIGHT, CameraSensor, surface_cloud
 from affordplan.world import Box, Workspace
 
+MAX_COORDINATE = 10.0  # metres: no contact, normal or motion component is larger
+OVERLAP_TOLERANCE = 0.002  # metres of penetration into an obstacle that reset() accepts (contact softness)
 MAX_CLOUD_POINTS = 100_000  # most points one cloud may ask for
 CHUNK_STEPS = 10  # physics steps between target updates and guard checks (20 ms)
 __all__ = ["CHUNK_STEPS", "TABLE_CONTACT_HEIGHT", "Outcome", "Protocol", "SimState", "Simulator"]
@@ -138,6 +141,9 @@ class Simulator:
             raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
         if not isinstance(obj, ObjectModel):
             raise InputError(f"obj must be an ObjectModel (see affordplan.load_object), got {type(obj).__name__}")
+        seed = as_seed("seed", seed)
+        if isinstance(obstacles, (str, bytes)) or not hasattr(obstacles, "__iter__"):
+            raise InputError(f"obstacles must be a sequence of affordplan.Box, got {describe(obstacles)}")
         obstacles = tuple(obstacles)
         for box in obstacles:
             if not isinstance(box, Box):
@@ -179,7 +185,8 @@ class Simulator:
         self.physics_time = 0.0  # seconds spent inside mj_step, for benchmarks
         self.physics_steps = 0
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
-        self.reset()
+        # Where an obstacle stands at the default start the object is thrown clear; reset() refuses such starts.
+        self.set_object_pose(obj.resting_states[0].pose((0.5, 0.0), 0.0))
 
     # ------------------------------------------------------------------ state
     def reset(self, resting_state: int = 0, xy=(0.5, 0.0), yaw: float = 0.0) -> np.ndarray:
@@ -187,19 +194,23 @@ class Simulator:
 
         Returns the settled 4x4 world pose.
         """
-        n = len(self.obj.resting_states)
-        if not isinstance(resting_state, (int, np.integer)) or not 0 <= resting_state < n:
-            raise InputError(f"resting_state must be an integer in [0, {n}), got {resting_state!r}")
-        xy = np.asarray(xy, dtype=float)
-        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not math.isfinite(yaw):
-            raise InputError(f"xy must be 2 finite numbers and yaw finite, got {xy!r}, {yaw!r}")
+        resting_state = as_whole("resting_state", resting_state, 0, len(self.obj.resting_states) - 1)
+        xy = as_vector("xy", xy, 2)
+        yaw = as_finite("yaw", yaw)
         if not self.workspace.contains(xy):
             raise InputError(f"xy={tuple(xy)} is outside the workspace {self.workspace}")
-        return self.set_object_pose(self.obj.resting_states[int(resting_state)].pose(xy, yaw))
+        return self.set_object_pose(self.obj.resting_states[int(resting_state)].pose(xy, yaw), check_clear=True)
 
-    def set_object_pose(self, T_world_object: np.ndarray, settle: bool = True) -> np.ndarray:
-        """Put the object at a 4x4 world pose (velocities zeroed), optionally let it settle."""
+    def set_object_pose(self, T_world_object: np.ndarray, settle: bool = True, check_clear: bool = False
+                        ) -> np.ndarray:
+        """Put the object at a 4x4 world pose (velocities zeroed), optionally let it settle.
+
+        ``check_clear``: raise :class:`InputError` (and leave the simulator as it was) when the object would overlap
+        an obstacle by more than ``OVERLAP_TOLERANCE``; physics would throw it out.
+        """
         T = check_pose(T_world_object, "T_world_object")
+        if check_clear and len(self._obstacle_geoms):
+            self._check_clear(T)
         mujoco.mj_resetData(self.model, self.data)
         quat = np.empty(4)
         mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
@@ -213,6 +224,29 @@ class Simulator:
             except _Abort:
                 pass
         return self.object_pose()
+
+    def _check_clear(self, T: np.ndarray) -> None:
+        """Raise :class:`InputError` when the object at ``T`` overlaps an obstacle (MuJoCo's contacts, one pass)."""
+        data = mujoco.MjData(self.model)
+        mujoco.mj_copyData(data, self.model, self.data)
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
+        data.qpos[self._object_qpos:self._object_qpos + 3] = T[:3, 3]
+        data.qpos[self._object_qpos + 3:self._object_qpos + 7] = quat
+        mujoco.mj_forward(self.model, data)
+        n = data.ncon
+        if n == 0:
+            return
+        geoms = np.array([data.contact.geom1[:n], data.contact.geom2[:n]]).T
+        object_geom = self.model.geom_bodyid[geoms] == self._object_body
+        obstacle = np.isin(geoms, self._obstacle_geoms)
+        pair = (object_geom[:, 0] & obstacle[:, 1]) | (object_geom[:, 1] & obstacle[:, 0])
+        deep = pair & (data.contact.dist[:n] < -OVERLAP_TOLERANCE)
+        if deep.any():
+            i = int(np.flatnonzero(deep)[0])
+            box = int(geoms[i][obstacle[i]][0])
+            raise InputError(f"the object at ({T[0, 3]:.3f}, {T[1, 3]:.3f}) m overlaps {self.model.geom(box).name} by "
+                             f"{1000 * -data.contact.dist[i]:.0f} mm; choose a start clear of the obstacles")
 
     def snapshot(self) -> SimState:
         """A copy of the current state, to :meth:`restore` later: e.g. to try several primitives from one start."""
@@ -473,7 +507,8 @@ class Simulator:
         if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
             names = [self.model.camera(i).name for i in range(self.model.ncam)]
             raise InputError(f"unknown camera {camera!r}; this scene has {names}")
-        key = (int(width), int(height))
+        buffer = self.model.vis.global_
+        key = (as_whole("width", width, 1, buffer.offwidth), as_whole("height", height, 1, buffer.offheight))
         if key not in self._renderers:
             self._renderers[key] = mujoco.Renderer(self.model, height=key[1], width=key[0])
         renderer = self._renderers[key]
@@ -488,7 +523,5 @@ class Simulator:
 
 
 def _vector(v, name: str) -> np.ndarray:
-    arr = np.asarray(v, dtype=float).reshape(-1)
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} must be 3 finite numbers, got {v!r}")
-    return arr
+    """3 finite numbers (metres or a unitless motion), at most ``MAX_COORDINATE`` in magnitude."""
+    return as_vector(name, v, 3, MAX_COORDINATE)
