@@ -228,5 +228,5 @@ def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[str, Skill
 def skills_sensor(skills: dict[str, Skill]) -> str:
     """The sensor a simulator should give ``skills`` (:attr:`Skill.sensor`): the one they were all trained on;
     ``"cameras"`` (the default sensor) when they disagree."""
-    sensors = {skill.sensor for skill in skills.values()}
+    sensors = {getattr(skill, "sensor", "cameras") for skill in skills.values()}  # duck-typed skills: the default
     return sensors.pop() if len(sensors) == 1 else "cameras"
