@@ -37,7 +37,7 @@ def plan(obj, goal, *, start=None, obstacles=(), time_limit=5.0, planner="afford
     return _plan(obj, goal, start=start, obstacles=obstacles, time_limit=time_limit, planner=planner, seed=seed,
                  **kwargs)
 
-__version__ = "0.23.0"
+__version__ = "0.24.0.dev0"
 
 
 def versions() -> dict[str, str]:

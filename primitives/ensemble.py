@@ -16,8 +16,6 @@ weights changed in the net after it is built are not seen. No gradients flow thr
 
 from __future__ import annotations
 
-from functools import partial
-
 import torch
 
 from affordplan.errors import InputError
@@ -36,9 +34,7 @@ class StackedEnsemble:
         self.n_members = len(members)
         self.width = first.weight.shape[0]
         self.n_decision = net.n_decision
-        from primitives.success import member_input  # (success imports this module)
-
-        self.member_input = partial(member_input, net.encoder)  # what the members read, from (obs, decision)
+        self.member_input = net.member_input  # what the members read, from (obs, decision)
         with torch.no_grad():
             # First point layer, all members at once: x (B*N, 9) @ (9, M*width).
             self.w_in = torch.cat([m.points[0].weight for m in members]).t().contiguous()

@@ -58,6 +58,7 @@ from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives import params as skill_params
 from primitives.env import OBS_DIM, SkillObservation, observe_cloud
+from primitives.weights_file import SHIPPED_DIR
 
 if TYPE_CHECKING:
     from affordplan.sim import Simulator
@@ -257,11 +258,16 @@ class FrameSearch:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
 
 
+def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None) -> FrameSearch | None:
+    """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
+    package's ``weights/``), if any."""
+    path = Path(weights_dir or SHIPPED_DIR) / f"{name}_frames.json"
+    return FrameSearch.load(path) if path.exists() else None
+
+
 def load_frame_search(skill: str, frames: str | os.PathLike) -> FrameSearch:
     """``"shipped"``: the frame search shipped beside ``skill``'s weights; else the frames.json at ``frames``.
     Raises :class:`InputError` where none is shipped or the file is unreadable."""
-    from primitives.skills import shipped_frame_search
-
     search = shipped_frame_search(skill) if str(frames) == "shipped" else FrameSearch.load(frames)
     if search is None:
         raise InputError(f"no frame search is shipped for {skill}")

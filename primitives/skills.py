@@ -36,7 +36,7 @@ from affordplan.errors import InputError, ReachabilityError
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.env import PRIMITIVES, SkillObservation, skill_observation
-from primitives.frames import FrameSearch, reframe_obs
+from primitives.frames import FrameSearch, reframe_obs, shipped_frame_search  # noqa: F401 (re-exported)
 from primitives.networks import HybridActorCritic
 from primitives.policy import greedy_action, load_policy
 from primitives.success import WEIGHTS_DIR, SuccessModel, load_success_net
@@ -161,13 +161,6 @@ class Skill:
         obs = np.asarray(obs, dtype=np.float32)
         p = self.success_model.predict(reframe_obs(obs, frames).reshape(-1, *obs.shape[-2:]))
         return self.frame_search.calibrate(p.reshape(*obs.shape[:-2], len(frames)).max(axis=-1), parameterised)
-
-
-def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None) -> FrameSearch | None:
-    """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
-    package's ``weights/``), if any."""
-    path = Path(weights_dir or WEIGHTS_DIR) / f"{name}_frames.json"
-    return FrameSearch.load(path) if path.exists() else None
 
 
 def load_skill(name: str, weights: str | os.PathLike | None = None,

@@ -354,7 +354,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
     the policy's decision there) with the frame-searched outcome: the data of a searched success model, which
     rates the searched skill from the goal frame alone (:func:`fit`).
     """
-    from primitives.evaluate import greedy_action
+    from primitives.policy import greedy_action
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
                                  episodes_per_object=4), seed=seed)
     rating, rows = [], _RolloutRows()
@@ -858,7 +858,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from primitives.evaluate import load_policy
+    from primitives.policy import load_policy
 
     if args.command == "frames":
         return _run_frames(args)
@@ -940,7 +940,7 @@ def _run(args: argparse.Namespace) -> int:
 
 def _run_frames(args: argparse.Namespace) -> int:
     """``frames``: frame-searched rollouts on training objects, and the Platt scaling of the chosen ratings."""
-    from primitives.evaluate import load_policy
+    from primitives.policy import load_policy
 
     asked = FrameSearch(args.turns, args.mirror, stand_ins=args.stand_ins)  # checks --turns / --stand-ins first
     search = replace(asked, stand_ins=0)  # the first pass calibrates the frames alone

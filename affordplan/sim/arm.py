@@ -134,7 +134,7 @@ def arm_actuator_xml() -> str:
 
 def ik_model_xml(obstacles: tuple[Box, ...]) -> str:
     """The arm-only model the IK runs on: the arm, the table and the obstacles."""
-    from affordplan.sim.scene import obstacle_geom_xml
+    from affordplan.sim.mjcf import obstacle_geom_xml
 
     boxes = "\n".join(obstacle_geom_xml(i, b) for i, b in enumerate(obstacles))
     return f"""<mujoco model="arm_ik">

@@ -10,11 +10,11 @@ collides with the object and obstacles but not the table (its targets are clampe
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from affordplan.objects.model import ObjectModel
+from affordplan.sim.mjcf import floats as _floats
+from affordplan.sim.mjcf import obstacle_geom_xml
 from affordplan.world import Box
 
 OBJECT_BODY = "object"
@@ -29,10 +29,6 @@ PARK_POSITION = (0.5, 0.0, -0.3)  # where the finger waits: under the table (it 
 # (a rubber mat, wood on wood) it tips; pushes low on the object still slide.
 TABLE_FRICTION = 0.8
 OBJECT_CONTACT = 'condim="6" friction="0.5 0.005 0.002" solref="0.005 1" solimp="0.95 0.99 0.001"'
-
-
-def _floats(values) -> str:
-    return " ".join(f"{v:.6g}" for v in np.asarray(values, dtype=float).reshape(-1))
 
 
 def _object_xml(obj: ObjectModel) -> tuple[str, str]:
@@ -54,17 +50,6 @@ def _object_xml(obj: ObjectModel) -> tuple[str, str]:
         + "\n</body>"
     )
     return "\n".join(assets), body
-
-
-def obstacle_geom_xml(i: int, box: Box) -> str:
-    """MJCF geom of obstacle ``i`` (named ``obstacle{i}``)."""
-    half = np.asarray(box.size) / 2
-    quat = [math.cos(box.yaw / 2), 0.0, 0.0, math.sin(box.yaw / 2)]
-    return (
-        f'<geom name="obstacle{i}" type="box" size="{_floats(half)}" '
-        f'pos="{_floats([box.center[0], box.center[1], half[2]])}" quat="{_floats(quat)}" '
-        f'contype="1" conaffinity="3" rgba="0.45 0.5 0.6 1" friction="0.5 0.005 0.002"/>'
-    )
 
 
 def _look_at(pos, target) -> str:
