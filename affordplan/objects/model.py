@@ -24,7 +24,7 @@ import numpy as np
 import trimesh
 
 from affordplan.checks import as_finite
-from affordplan.errors import MeshError
+from affordplan.errors import InputError, MeshError
 from affordplan.objects import decompose, family, housekeep, repair
 from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states, yaw_period
 from affordplan.objects.shapes import CATALOGUE, Shape
@@ -158,10 +158,19 @@ def _read_mesh(path: Path) -> trimesh.Trimesh:
     return loaded
 
 
-def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float, density: float, what: str,
+def _from_mesh(name: str, mesh: trimesh.Trimesh, size: float | None, density: float, what: str,
                shipped: str | None = None) -> ObjectModel:
-    """``shipped``: a household object's name, whose convex parts are shipped (:mod:`.housekeep`)."""
-    made = repair.solid(repair.clean(mesh, what), what)
+    """``shipped``: a household object's name, whose convex parts are shipped (:mod:`.housekeep`). ``size`` None:
+    the source's own largest half-extent (its units taken as metres)."""
+    cleaned = repair.clean(mesh, what)  # raises for non-finite or empty input before the size is read
+    if size is None:
+        size = 0.5 * float(np.max(np.ptp(np.asarray(mesh.vertices, dtype=float), axis=0)))
+        try:
+            _check_size(size, density)
+        except InputError as exc:
+            raise InputError(f"{what} keeps its own size (size=None), but {exc}; give size= in metres, or convert "
+                             "the mesh to metres") from None
+    made = repair.solid(cleaned, what)
     # Decompose in a normalised frame so cache keys do not depend on the source's units.
     probe = _finish(name, made.surface, made.volume, [], size, density)
     vertices = housekeep.shipped_parts(shipped, probe.mesh.vertices, size) if shipped else None
@@ -183,21 +192,55 @@ def _check_size(size: float, density: float) -> None:
     as_finite("density (kg/m^3)", density, *DENSITY_RANGE)
 
 
-def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_DENSITY) -> ObjectModel:
+def load_object(source, *, size: float | None = DEFAULT_SIZE, density: float = DEFAULT_DENSITY) -> ObjectModel:
     """Load an object and normalise it.
 
     Args:
         source: a catalogue name (see :func:`catalogue`), ``"housekeep/NAME"`` (HACMan's household meshes,
             :func:`affordplan.objects.housekeep.names`), a mesh file path, or a ``trimesh.Trimesh``.
-        size: the largest half-extent after normalisation, metres.
+        size: the largest half-extent after normalisation, metres (HACMan scales objects this way); ``None`` keeps
+            the source's own size, its units taken as metres.
         density: kg/m^3, for the mass and inertia.
+
+    Warns:
+        UserWarning: the object is far from what the skills trained on (its size, its aspect, its thinnest width),
+            naming what is unusual (:func:`unusual`).
 
     Raises:
         MeshError: the source is unknown, missing, unreadable, empty, non-finite, flat or has zero
             volume; the message names which (see :mod:`affordplan.objects.repair`).
-        InputError: ``size`` or ``density`` is not a positive finite number.
+        InputError: ``size`` (given, or the source's own) or ``density`` out of range.
     """
-    _check_size(size, density)
+    _check_size(DEFAULT_SIZE if size is None else size, density)
+    obj = _load(source, size, density)
+    note = unusual(obj)
+    if note:
+        warnings.warn(f"{obj.name}: {note}; the skills trained on objects of 8-12 cm whose sides differ by at most "
+                      "a factor of 6, and may fail or misjudge their odds on this one", stacklevel=2)
+    return obj
+
+
+# What the skills trained on: the procedural family's largest half-extents (0.05 m x 0.8-1.2), with margins.
+TRAINED_HALF_EXTENT = (0.035, 0.075)  # metres
+TRAINED_ASPECT = 6.0  # longest / shortest side
+TRAINED_THINNEST = 0.012  # metres
+
+
+def unusual(obj: ObjectModel) -> str:
+    """What puts ``obj`` far outside what the skills trained on ("" when nothing does)."""
+    extents = np.sort(np.asarray(obj.mesh.extents))
+    half = 0.5 * extents[-1]
+    notes = []
+    if not TRAINED_HALF_EXTENT[0] <= half <= TRAINED_HALF_EXTENT[1]:
+        notes.append(f"its largest half-extent is {100 * half:.1f} cm")
+    if extents[-1] > TRAINED_ASPECT * extents[0]:
+        notes.append(f"its longest side is {extents[-1] / extents[0]:.0f} times its shortest")
+    if extents[0] < TRAINED_THINNEST:
+        notes.append(f"it is {1000 * extents[0]:.0f} mm thin")
+    return ", ".join(notes)
+
+
+def _load(source, size: float | None, density: float) -> ObjectModel:
     if isinstance(source, trimesh.Trimesh):
         return _from_mesh("mesh", source, size, density, "mesh")
     if isinstance(source, trimesh.Scene):
@@ -212,7 +255,9 @@ def load_object(source, *, size: float = DEFAULT_SIZE, density: float = DEFAULT_
             raise MeshError(f"empty object name; give a catalogue name ({', '.join(CATALOGUE)}), "
                             "housekeep/NAME or a mesh file path")
         if text in CATALOGUE:
-            return _from_shape(text, CATALOGUE[text](), size, density)
+            shape = CATALOGUE[text]()
+            return _from_shape(text, shape, 0.5 * float(np.max(shape.mesh.extents)) if size is None else size,
+                               density)
         if text.startswith(housekeep.PREFIX):
             path = housekeep.mesh_path(text)
             with warnings.catch_warnings():  # their repairs are known and documented (PROVENANCE.md), not news
