@@ -76,6 +76,8 @@ class Execution:
         log: one entry per primitive.
         reason: why it stopped.
         frames: rendered frames, when asked for.
+        errors: the final ``(position error m, yaw error rad, resting state right)`` against the goal
+            (:meth:`affordplan.Goal.errors`; the yaw error is 0 for a goal without a yaw).
     """
 
     success: bool
@@ -86,10 +88,15 @@ class Execution:
     reason: str = ""
     planning_time: float = 0.0
     frames: list[np.ndarray] = field(default_factory=list, repr=False)
+    errors: tuple[float, float, bool] | None = None
 
     def __str__(self) -> str:
         head = (f"execution: {'SUCCESS' if self.success else 'FAILED'} after {self.n_primitives} primitives, "
                 f"{self.replans} replans ({self.reason})")
+        if self.errors is not None:
+            d, yaw, state_ok = self.errors
+            head += (f"; final error {100 * d:.1f} cm, {math.degrees(yaw):.0f} deg, resting state "
+                     f"{'right' if state_ok else 'WRONG'}")
         return "\n".join([head] + [f"  {e}" for e in self.log])
 
 
@@ -242,7 +249,8 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
             break
         k += 1
     T = sim.object_pose()
-    return Execution(goal.reached(obj, T), T, len(log), replans, log, reason, planning_time, frames)
+    return Execution(goal.reached(obj, T), T, len(log), replans, log, reason, planning_time, frames,
+                     goal.errors(obj, T))
 
 
 # ------------------------------------------------------------------------------- greedy
@@ -296,4 +304,4 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
             reason = stop
             break
     T = sim.object_pose()
-    return Execution(goal.reached(obj, T), T, len(log), 0, log, reason, planning_time, frames)
+    return Execution(goal.reached(obj, T), T, len(log), 0, log, reason, planning_time, frames, goal.errors(obj, T))

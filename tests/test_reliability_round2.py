@@ -111,3 +111,10 @@ def test_command_line_arguments_are_checked_before_any_work(tmp_path, capsys, ar
     assert rc == 2
     err = capsys.readouterr().err
     assert words in err and "Traceback" not in err
+
+
+def test_an_execution_prints_its_final_errors(cube_plan):
+    execution = cube_plan.execute(sim="finger", max_primitives=1)
+    d, yaw, state_ok = execution.errors
+    head = str(execution).splitlines()[0]
+    assert f"final error {100 * d:.1f} cm, {math.degrees(yaw):.0f} deg, resting state" in head
