@@ -324,6 +324,7 @@ def test_cli_bench_json(capsys):
     assert data[0]["primitives_per_s"] > 0
 
 
+@pytest.mark.slow
 def test_bench_query_times_each_rater_of_each_skill(capsys):
     import torch
 
@@ -356,6 +357,7 @@ def test_run_scene_refuses_a_primitive_budget_that_is_not_a_whole_number(max_pri
     assert not any(tmp_path.iterdir())  # refused before anything was written
 
 
+@pytest.mark.slow
 def test_bench_query_times_a_candidate_folder_and_refuses_a_missing_one(capsys, tmp_path):
     from primitives.skills import WEIGHTS_DIR
 
@@ -388,6 +390,7 @@ def test_bench_query_puts_the_thread_count_back_when_it_refuses_a_folder(tmp_pat
         torch.set_num_threads(before)
 
 
+@pytest.mark.slow
 def test_bench_query_interleaves_the_skills_in_rounds(monkeypatch):
     import primitives.querybench as qb
 

@@ -64,6 +64,7 @@ def figures(seed: int) -> dict:
     return result
 
 
+@pytest.mark.slow
 def test_same_seed_same_evaluation_figures():
     assert figures(5) == figures(5)
 
@@ -81,6 +82,7 @@ print(json.dumps({{"sim": h.hexdigest(), "figures": figures(7)}}, sort_keys=True
 """
 
 
+@pytest.mark.slow
 def test_two_processes_agree():
     """Separate interpreters with different hash seeds: same poses (hashed bitwise), same figures."""
     runs = []

@@ -10,6 +10,7 @@ from primitives.frame_ceiling import frame_ceiling, main
 from primitives.frames import load_frame_search
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("skill", "params"), [("spin", "random"), ("push", "none")])
 def test_the_goal_frame_and_the_searchs_pick_are_what_evaluate_measures_on_the_same_starts(skill, params):
     """Row 0 is the policy as trained, the pick is the shipped skill's choice (push with the seed's objective

@@ -113,6 +113,7 @@ def test_a_roll_that_ends_one_roll_away_is_a_roll_to_that_state():
     assert achieved("roll", obj, _outcome(T0, _moved(T0, dxy=(0.02, 0.0)))) is None  # same state
 
 
+@pytest.mark.slow
 def test_training_with_hindsight_stores_copies_but_counts_primitives(tmp_path):
     cfg = TrainConfig(primitive="spin", steps=60, workers=0, seed=0, out=str(tmp_path), objects=("cube",),
                       learning_starts=20, replay_size=1000, n_points=64, checkpoint_minutes=60.0, p_params=0.85,

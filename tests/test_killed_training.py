@@ -22,6 +22,7 @@ from primitives import killtest
 from primitives import train as train_mod
 
 
+@pytest.mark.slow
 def test_one_kill_and_resume_continues_from_the_checkpoint(tmp_path):
     result = killtest.killtest("push", kills=1, out=tmp_path / "kt", steps=250, interval_s=0.5, workers=0,
                                seed=0, window=(1.0, 1.5), check_truncated=False, timeout=120, log=lambda *a: None)
@@ -66,6 +67,7 @@ _WRITER = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 def test_checkpoint_writes_are_atomic_under_sigkill(tmp_path):
     """A writer saving 8 MB checkpoints in a loop is killed mid-stream three times: the file on disk
     always loads, whole, as one of the checkpoints it finished."""

@@ -149,6 +149,7 @@ def household(request):
     return request.param, obj, caught
 
 
+@pytest.mark.slow
 def test_household_meshes_load_normalised_with_resting_states(household):
     name, obj, caught = household
     assert obj.name == name.rsplit(".", 1)[0]
@@ -168,6 +169,7 @@ def test_household_mesh_settles_in_its_resting_state(household):
     assert T[2, 3] == pytest.approx(obj.resting_states[0].height, abs=0.004)
 
 
+@pytest.mark.slow
 def test_non_convex_user_mesh_is_decomposed_and_cached(tmp_path, monkeypatch):
     monkeypatch.setenv("AFFORDPLAN_CACHE", str(tmp_path))
     mesh = trimesh.load(DATA / "household" / "pybullet_mug.obj", force="mesh")

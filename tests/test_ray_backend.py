@@ -30,6 +30,7 @@ def _quiet_ray(monkeypatch):
     monkeypatch.setenv("RAY_USAGE_STATS_ENABLED", "0")  # never report anything over the network
 
 
+@pytest.mark.slow
 def test_cli_ray_run_writes_checkpoint_and_policy(tmp_path):
     """`python -m primitives.train push --backend ray --steps 64 --workers 1 --out DIR`, in-process."""
     was_running = ray.is_initialized()
@@ -105,6 +106,7 @@ def test_pushed_weights_reach_the_workers(backend, request):
         assert ray.is_initialized()  # a source that did not start Ray leaves it running
 
 
+@pytest.mark.slow
 def test_ray_run_learns_syncs_and_resumes(tmp_path, ray_instance):
     cfg = TrainConfig(primitive="push", steps=64, workers=1, backend="ray", seed=3, out=str(tmp_path),
                       objects=("cube",), n_points=64, learning_starts=32, replay_size=256, replay_ratio=16.0,

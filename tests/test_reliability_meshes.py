@@ -175,6 +175,7 @@ def test_scales_from_a_millimetre_to_a_kilometre_load_the_same_object(tmp_path, 
                                                                     rel=1e-5)
 
 
+@pytest.mark.slow
 def test_a_million_faces_load_decimated_in_seconds(tmp_path):
     sphere = trimesh.creation.icosphere(subdivisions=8)  # 1,310,720 faces
     sphere.apply_scale([1.0, 0.7, 0.5])

@@ -123,6 +123,7 @@ def _cube_config(out, steps: int) -> TrainConfig:
                        checkpoint_minutes=60.0, p_params=0.0)
 
 
+@pytest.mark.slow
 def test_checkpoint_resume_round_trips(tmp_path):
     summary = train(_cube_config(tmp_path, 120), progress=False)
     saved = ckpt.load(tmp_path / "checkpoint.pt")
@@ -139,6 +140,7 @@ def test_checkpoint_resume_round_trips(tmp_path):
     assert json.loads((tmp_path / "config.json").read_text())["steps"] == 160
 
 
+@pytest.mark.slow
 def test_resume_lets_go_of_the_loaded_checkpoint(tmp_path, monkeypatch):
     """After --resume restores the replay into its preallocated buffer, the loaded checkpoint's copy of the
     replay is freed before training goes on (else a resumed run holds the replay twice: +250 MB on spin's
@@ -192,6 +194,7 @@ def _random_push(n=40):
 
 @pytest.mark.parametrize("precision", ["fp32", pytest.param("bf16", marks=pytest.mark.skipif(
     not bf16_is_fast(), reason="no native bfloat16 on this CPU: emulated, too slow for the suite"))])
+@pytest.mark.slow
 def test_tiny_run_on_the_cube_learns_to_push(tmp_path, precision):
     """500 primitives on the cube: the greedy policy beats a random one by >= 0.3 in mean reward
     (the seed's push loss) and by >= 5 points of push success, with the learner in float32 or bf16."""
