@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Mapping
@@ -103,8 +104,10 @@ def read(path: str | os.PathLike, what: str = "weights") -> Any:
         text = str(exc).strip().splitlines()
         first = text[0][:200] if text else type(exc).__name__
         if "Unsupported global" in str(exc) or "GLOBAL" in str(exc):  # an object torch would have to construct
+            found = re.search(r"GLOBAL ([\w.]+)", str(exc))
+            what = f" ({found.group(1)})" if found else ""
             raise WeightsError(f"{path} is not a safe weights file: it holds objects other than tensors and plain "
-                               f"values (loading it could run code), so it was not loaded ({first})") from exc
+                               f"values{what}, which loading could run as code, so it was not loaded") from None
         raise WeightsError(f"{what} {path} is damaged or truncated ({type(exc).__name__}: {first})") from exc
 
 
