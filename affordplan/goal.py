@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from affordplan.checks import as_finite, as_vector, as_whole, describe
+from affordplan.checks import as_finite, as_vector, describe, is_whole
 from affordplan.errors import GoalError, InputError
 from affordplan.geometry import wrap_period
 from affordplan.objects.model import ObjectModel
@@ -42,10 +42,12 @@ class Goal:
         try:
             xy = as_vector("goal xy (metres)", self.xy, 2)
             yaw = None if self.yaw is None else as_finite("goal yaw (radians)", self.yaw)
-            state = None if self.resting_state is None else as_whole("goal resting_state", self.resting_state)
             tolerances = [as_finite(f"goal {name}", getattr(self, name)) for name in ("xy_tol", "yaw_tol")]
         except InputError as exc:
             raise GoalError(str(exc)) from None
+        if self.resting_state is not None and not is_whole(self.resting_state):  # its range: plan() checks it
+            raise GoalError(f"goal resting_state must be an integer index or None, got {describe(self.resting_state)}")
+        state = None if self.resting_state is None else int(self.resting_state)
         if not isinstance(self.yaw_symmetric, (bool, np.bool_)):
             raise GoalError(f"goal yaw_symmetric must be True or False, got {describe(self.yaw_symmetric)}")
         for name, v in zip(("xy_tol", "yaw_tol"), tolerances):

@@ -342,7 +342,7 @@ class Simulator:
         contact; by default that of the nearest surface sample.
         """
         contact = _vector(contact, "contact")
-        motion = np.clip(_vector(motion, "motion"), -1.0, 1.0)
+        motion = np.clip(as_vector("motion", motion, 3), -1.0, 1.0)  # any finite motion; clipped as documented
         normal, touch, pre = self._approach_points(contact, normal)
         p = self.protocol
         steps0 = self.physics_steps
