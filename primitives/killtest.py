@@ -283,6 +283,9 @@ def killtest(primitive: str = "push", kills: int = 5, out: str | os.PathLike = "
             run.kill_group()
             run.proc.wait()
         polite_ok = name == "KILL" or run.proc.returncode == 130
+        if not polite_ok:
+            log(f"stop {i + 1} ({name}): exit status {run.proc.returncode}; stderr ends:\n  "
+                + "\n  ".join(run.stderr_tail[-8:]))
         time.sleep(2.0 if children else 0.2)  # give orphaned workers time to notice, if they can
         orphans = [pid for pid in children if _alive(pid)]
         orphan_commands = [_command(pid) for pid in orphans]
