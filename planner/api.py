@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from affordplan.checks import as_finite, as_vector, as_whole
+from affordplan.checks import as_finite, as_seed, as_vector, as_whole, describe
 from affordplan.errors import GoalError, InputError
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
@@ -99,8 +99,12 @@ def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] =
         raise InputError(f"planner must be one of {PLANNERS}, got {planner!r}")
     if not isinstance(goal, Goal):
         raise GoalError(f"goal must be an affordplan.Goal, got {type(goal).__name__}")
-    if not (isinstance(time_limit, (int, float)) and math.isfinite(time_limit) and time_limit > 0):
-        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit!r}")
+    time_limit = as_finite("time_limit (seconds)", time_limit, 0.0, 3600.0)
+    if time_limit == 0.0:
+        raise InputError("time_limit must be a positive number of seconds, got 0")
+    seed = as_seed("seed", seed)
+    if isinstance(obstacles, (str, bytes)) or not hasattr(obstacles, "__iter__"):
+        raise InputError(f"obstacles must be a sequence of affordplan.Box, got {describe(obstacles)}")
     T0 = start_pose(obj, start)
     obstacles = tuple(obstacles)
     p = Planner(obj, obstacles, workspace, predictor=predictor, time_limit=time_limit, seed=seed)

@@ -36,7 +36,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from affordplan.checks import is_whole
+from affordplan.checks import as_finite, is_whole
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z, wrap_angle
 from affordplan.objects.model import ObjectModel
@@ -90,12 +90,7 @@ def check(skill: str, params, obj: ObjectModel | None = None, state: int | None 
                 raise InputError(f"resting state {value} of {obj.name} is not one roll away from state {state} "
                                  f"(one roll away: {roll_targets(obj, state)})")
         return {"target": int(value)}
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{skill} {key} must be a number in radians, got {value!r}") from None
-    if not math.isfinite(value):
-        raise InputError(f"{skill} {key} must be finite, got {value!r}")
+    value = as_finite(f"{skill} {key} (radians)", value)
     if skill == "push":
         return {"direction": wrap_angle(value)}
     if not SPIN_MIN - 1e-9 <= abs(value) <= SPIN_MAX + 1e-9:

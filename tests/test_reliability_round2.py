@@ -118,3 +118,18 @@ def test_an_execution_prints_its_final_errors(cube_plan):
     d, yaw, state_ok = execution.errors
     head = str(execution).splitlines()[0]
     assert f"final error {100 * d:.1f} cm, {math.degrees(yaw):.0f} deg, resting state" in head
+
+
+@pytest.mark.parametrize("kwargs", [dict(seed=-1), dict(obstacles=None), dict(time_limit=True), dict(time_limit=0),
+                                    dict(time_limit=float("nan"))])
+def test_plan_arguments(cube, kwargs):
+    with pytest.raises(InputError):
+        ap.plan(cube, ap.Goal((0.6, 0.0)), **kwargs)
+
+
+@pytest.mark.parametrize("value", [True, 10**400, "a", float("inf"), None])
+def test_skill_parameters_refuse_booleans_and_huge_numbers(cube, value):
+    from primitives.params import check
+
+    with pytest.raises(InputError):
+        check("push", {"direction": value}, cube, 0)
