@@ -161,6 +161,7 @@ def test_household_meshes_load_normalised_with_resting_states(household):
     assert any("convex hull" in str(w.message) for w in caught)
 
 
+@pytest.mark.slow  # its fixture runs CoACD on three test meshes (75 s on a fresh machine)
 def test_household_mesh_settles_in_its_resting_state(household):
     _, obj, _ = household
     sim = ap.Simulator(obj)
