@@ -19,7 +19,7 @@ import numpy as np
 
 from affordplan.errors import InputError
 from affordplan.objects.model import ObjectModel
-from affordplan.sim.scene import OBJECT_BODY, build_mjcf
+from affordplan.sim.scene import OBJECT_BODY, build_mjcf, set_free_pose
 from affordplan.sim.sensor import CameraSensor, surface_cloud
 from affordplan.world import Box
 from primitives import params as skill_params
@@ -75,6 +75,7 @@ class Predictor:
         self._samples, self._normals = obj.surface_samples()
         self._seed = seed
         self._cameras: tuple[mujoco.MjData, CameraSensor, int] | None = None
+        self._radius = float(np.max(np.linalg.norm(obj.hull.vertices, axis=1)))  # bounds the object, metres
         self.queries = 0
 
     def _camera_scene(self) -> tuple[mujoco.MjData, CameraSensor, int]:
@@ -93,13 +94,9 @@ class Predictor:
         rng = np.random.default_rng(self._seed)
         if self.sensor == "cameras":
             data, camera, adr = self._camera_scene()
-            quat = np.empty(4)
-            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T_world_object[:3, :3]).reshape(-1))
-            data.qpos[adr:adr + 3] = T_world_object[:3, 3]
-            data.qpos[adr + 3:adr + 7] = quat
+            set_free_pose(data, adr, T_world_object)
             mujoco.mj_kinematics(camera.model, data)
-            radius = float(np.max(np.linalg.norm(self.obj.hull.vertices, axis=1)))
-            points, normals = camera.cloud(data, rng, radius, N_POINTS)
+            points, normals = camera.cloud(data, rng, self._radius, N_POINTS)
             if len(points):
                 return points, normals
         return surface_cloud(self._samples, self._normals, T_world_object, rng, N_POINTS)

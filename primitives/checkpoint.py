@@ -34,8 +34,6 @@ def load(path: str | Path, skill: str | None = None) -> dict:
     """
     try:
         payload, meta = weights_file.load(path, kind="checkpoint", skill=skill)
-    except CheckpointError:
-        raise
     except WeightsError as exc:
         raise CheckpointError(str(exc)) from exc
     if "model" not in payload:

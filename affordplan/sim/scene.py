@@ -10,6 +10,7 @@ collides with the object and obstacles but not the table (its targets are clampe
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 
 from affordplan.objects.model import ObjectModel
@@ -29,6 +30,14 @@ PARK_POSITION = (0.5, 0.0, -0.3)  # where the finger waits: under the table (it 
 # (a rubber mat, wood on wood) it tips; pushes low on the object still slide.
 TABLE_FRICTION = 0.8
 OBJECT_CONTACT = 'condim="6" friction="0.5 0.005 0.002" solref="0.005 1" solimp="0.95 0.99 0.001"'
+
+
+def set_free_pose(data: mujoco.MjData, qpos_adr: int, T_world_object: np.ndarray) -> None:
+    """Write a 4x4 world pose into a free joint's ``qpos`` (position, then the rotation as a quaternion)."""
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T_world_object[:3, :3]).reshape(-1))
+    data.qpos[qpos_adr:qpos_adr + 3] = T_world_object[:3, 3]
+    data.qpos[qpos_adr + 3:qpos_adr + 7] = quat
 
 
 def _object_xml(obj: ObjectModel) -> tuple[str, str]:

@@ -29,7 +29,7 @@ from affordplan.objects.model import ObjectModel
 from affordplan.sim.arm import HOME, ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
 from affordplan.sim.pushers import ArmPusher, FingerPusher
-from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf
+from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf, set_free_pose
 from affordplan.sim.sensor import SENSORS, TABLE_CONTACT_HEIGHT, CameraSensor, surface_cloud
 from affordplan.world import Box, Workspace
 
@@ -212,10 +212,7 @@ class Simulator:
         if check_clear and len(self._obstacle_geoms):
             self._check_clear(T)
         mujoco.mj_resetData(self.model, self.data)
-        quat = np.empty(4)
-        mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
-        self.data.qpos[self._object_qpos:self._object_qpos + 3] = T[:3, 3]
-        self.data.qpos[self._object_qpos + 3:self._object_qpos + 7] = quat
+        set_free_pose(self.data, self._object_qpos, T)
         self._pusher.home()
         if settle:
             try:
@@ -229,10 +226,7 @@ class Simulator:
         """Raise :class:`InputError` when the object at ``T`` overlaps an obstacle (MuJoCo's contacts, one pass)."""
         data = mujoco.MjData(self.model)
         mujoco.mj_copyData(data, self.model, self.data)
-        quat = np.empty(4)
-        mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
-        data.qpos[self._object_qpos:self._object_qpos + 3] = T[:3, 3]
-        data.qpos[self._object_qpos + 3:self._object_qpos + 7] = quat
+        set_free_pose(data, self._object_qpos, T)
         mujoco.mj_forward(self.model, data)
         n = data.ncon
         if n == 0:
@@ -282,15 +276,14 @@ class Simulator:
             InputError: ``n`` is not a whole number in [1, 100000].
             PerceptionError: no camera sees the object (it is hidden behind obstacles or the arm).
         """
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 0 < n <= MAX_CLOUD_POINTS:
-            raise InputError(f"n must be a whole number in [1, {MAX_CLOUD_POINTS}], got {str(n)[:40]}")
+        n = as_whole("n", n, 1, MAX_CLOUD_POINTS)
         if self._camera is not None:
             mujoco.mj_kinematics(self.model, self.data)
-            points, normals = self._camera.cloud(self.data, self._rng, self._radius, int(n))
+            points, normals = self._camera.cloud(self.data, self._rng, self._radius, n)
             if len(points) == 0:
                 raise PerceptionError("no camera sees the object (hidden behind obstacles or the arm)")
             return points, normals
-        return surface_cloud(self._samples_obj, self._normals_obj, self.object_pose(), self._rng, int(n))
+        return surface_cloud(self._samples_obj, self._normals_obj, self.object_pose(), self._rng, n)
 
     def surface_normal(self, point_world: np.ndarray) -> np.ndarray:
         """Outward normal (world frame) of the surface sample nearest to ``point_world``."""
