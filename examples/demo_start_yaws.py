@@ -2,14 +2,14 @@
 
     python examples/demo_start_yaws.py                 # the nine yaws the README quotes
     python examples/demo_start_yaws.py -150 0 90       # yaws of your own, degrees
-    python examples/demo_start_yaws.py --weights-dir primitives/weights/candidates/push_0.18   # other skill files
+    python examples/demo_start_yaws.py --weights-dir candidates/push_0.18   # other skill files
 """
 
 import argparse
 import math
 
 import affordplan as ap
-from affordplan.scene_file import demo_scene
+from affordplan.app.scene_file import demo_scene
 from planner.predict import Predictor
 
 YAWS_DEG = (29.0, -150.0, -105.0, -60.0, -15.0, 30.0, 75.0, 120.0, 165.0)

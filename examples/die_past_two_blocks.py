@@ -7,7 +7,7 @@ import math
 import sys
 
 import affordplan as ap
-from planner.example import run_example
+from affordplan.app.example import run_example
 
 if __name__ == "__main__":
     die = ap.load_object("cube")

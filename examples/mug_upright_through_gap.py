@@ -9,7 +9,7 @@ import sys
 import numpy as np
 
 import affordplan as ap
-from planner.example import run_example
+from affordplan.app.example import run_example
 
 if __name__ == "__main__":
     mug = ap.load_object("mug")

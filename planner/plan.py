@@ -40,8 +40,7 @@ from affordplan.errors import GoalError, PlanningError
 from affordplan.geometry import wrap_angle
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
-from affordplan.sim.arm import FINGERTIP_REACH, TIP_RADIUS
-from affordplan.sim.simulator import Protocol
+from affordplan.robot import FINGERTIP_REACH, TIP_RADIUS, Protocol
 from affordplan.world import Box, Workspace
 from planner import chain
 from planner.footprint import footprint, inflate, place

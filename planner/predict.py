@@ -23,7 +23,7 @@ from affordplan.sim.scene import OBJECT_BODY, build_mjcf, set_free_pose
 from affordplan.sim.sensor import CameraSensor, surface_cloud
 from affordplan.world import Box
 from primitives import params as skill_params
-from primitives.env import observe_cloud
+from primitives.observation import observe_cloud
 from primitives.skills import Skill, load_skills, skills_sensor
 
 N_POINTS = 256

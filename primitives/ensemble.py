@@ -1,6 +1,6 @@
 """The success ensemble in a form for answering queries: all members in a few batched matrix products.
 
-:class:`primitives.success.SuccessNet` keeps its members as separate modules, which is what training and the
+:class:`primitives.training.success.SuccessNet` keeps its members as separate modules, which is what training and the
 shipped files want (one optimiser per member's parameters, ``members.K.*`` keys). Answering a query that way runs
 every layer once per member: 25 small matrix products for five members, each paying torch's per-call overhead on a
 cloud of a few hundred points. :class:`StackedEnsemble` holds the same weights stacked:
@@ -22,7 +22,7 @@ from affordplan.errors import InputError
 
 
 class StackedEnsemble:
-    """P(success) from a :class:`~primitives.success.SuccessNet`'s weights, stacked across its members.
+    """P(success) from a :class:`~primitives.training.success.SuccessNet`'s weights, stacked across its members.
 
     Args:
         net: the ensemble to snapshot (any number of members, any ``n_decision``).
@@ -49,7 +49,7 @@ class StackedEnsemble:
     @torch.no_grad()
     def __call__(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
         """Calibrated probability of success ``(B,)`` from observations ``(B, N, 9)`` (goal frame, metres) and
-        decision features ``(B, >= n_decision)`` (:func:`primitives.success.decision_features`)."""
+        decision features ``(B, >= n_decision)`` (:func:`primitives.training.success.decision_features`)."""
         if obs.ndim != 3 or decision.ndim != 2 or decision.shape[0] != obs.shape[0] \
                 or decision.shape[1] < self.n_decision:
             raise InputError(f"expected observations (B, N, 9) and decision features (B, >= {self.n_decision}), "

@@ -57,7 +57,7 @@ from affordplan.checks import is_whole, require_whole
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives import params as skill_params
-from primitives.env import OBS_DIM, SkillObservation, observe_cloud
+from primitives.observation import OBS_DIM, SkillObservation, observe_cloud
 from primitives.weights_file import SHIPPED_DIR
 
 if TYPE_CHECKING:

@@ -10,7 +10,7 @@
 The contact is chosen from the critic map: ``softmax(Q / T)`` over points with epsilon-greedy
 exploration in training, the argmax at evaluation (HACMan's rule).
 
-Input per point: 9 features (position, normal, goal flow; :mod:`primitives.env`). Weights trained on
+Input per point: 9 features (position, normal, goal flow; :mod:`primitives.training.env`). Weights trained on
 the first 6 alone (the seed's objective, before parameters) load through :func:`widen_input`, which
 gives the goal-flow inputs zero weight: the network computes exactly what it did before.
 """

@@ -35,11 +35,12 @@ import torch
 from affordplan.errors import InputError, ReachabilityError
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
-from primitives.env import PRIMITIVES, SkillObservation, skill_observation
 from primitives.frames import FrameSearch, reframe_obs, shipped_frame_search  # noqa: F401 (re-exported)
 from primitives.networks import HybridActorCritic
+from primitives.observation import PRIMITIVES, SkillObservation, skill_observation
 from primitives.policy import greedy_action, load_policy
-from primitives.success import WEIGHTS_DIR, SuccessModel, load_success_net
+from primitives.success_model import SuccessModel, load_success_net
+from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -149,7 +150,7 @@ class Skill:
 
     def success_probability_obs(self, obs: np.ndarray, parameterised: bool = True) -> np.ndarray:
         """Predicted P(success) for observations ``(N, 9)`` or ``(B, N, 9)`` built in the goal frame
-        (:func:`primitives.env.observe_cloud`), all with a parameter or all without; with a frame search, the
+        (:func:`primitives.training.env.observe_cloud`), all with a parameter or all without; with a frame search, the
         searched success model's answer, or without one the calibrated rating of the best free frame (for the
         seed's objective a lower bound where the search has stand-ins: rating those needs the object and its
         resting state, which an observation does not carry; :meth:`success_probability` rates them)."""

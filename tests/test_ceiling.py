@@ -10,8 +10,9 @@ import pytest
 
 import affordplan as ap
 from affordplan.errors import InputError
-from primitives import ceiling, rewards
-from primitives.ceiling import CLOUD_POINTS, candidates_for, push_candidates
+from primitives import rewards
+from primitives.research import ceiling
+from primitives.research.ceiling import CLOUD_POINTS, candidates_for, push_candidates
 
 
 def test_candidates_face_the_push_and_hug_the_centre_line(cube):
@@ -89,7 +90,7 @@ def test_a_centre_line_push_moves_the_cube_straight(cube):
 
 def test_bad_command_lines_get_a_clear_error_not_a_traceback(tmp_path, capsys):
     """Missing weights or a mesh that does not load: one line on stderr, exit status 2; no starts: a usage error."""
-    from primitives import evaluate, success
+    from primitives.training import evaluate, success
 
     missing = str(tmp_path / "nope.pt")
     assert ceiling.main(["--starts", "1", "--weights", missing]) == 2
@@ -99,7 +100,7 @@ def test_bad_command_lines_get_a_clear_error_not_a_traceback(tmp_path, capsys):
     broken = tmp_path / "broken.obj"
     broken.write_text("not a mesh")
     assert evaluate.main(["push", "--trials", "1", "--objects", str(broken)]) == 2
-    assert "primitives.evaluate: error:" in capsys.readouterr().err
+    assert "primitives.training.evaluate: error:" in capsys.readouterr().err
     assert success.main(["evaluate", "spin", "--model", missing, "--rollouts", "1", "--out", str(tmp_path)]) == 2
     assert "no success model at" in capsys.readouterr().err
     for main, argv in ((ceiling.main, ["--starts", "0"]), (evaluate.main, ["push", "--trials", "0"]),

@@ -14,11 +14,11 @@ import pytest
 from PIL import Image
 
 import affordplan as ap
-from affordplan import cli
-from affordplan.bench import bench_sim
+from affordplan.app import cli
+from affordplan.app.bench.primitive import bench_sim
+from affordplan.app.scene_file import DEMO_SCENE, demo_scene, load_scene, parse_scene
+from affordplan.app.video import write_video
 from affordplan.errors import InputError, MeshError
-from affordplan.scene_file import DEMO_SCENE, demo_scene, load_scene, parse_scene
-from affordplan.video import write_video
 
 SCENES = Path(__file__).parents[1] / "examples" / "scenes"
 
@@ -153,15 +153,15 @@ def test_every_subcommand_help_shows_an_example(argv, capsys):
 
 
 def test_bench_registers_robustness_when_it_exists(monkeypatch, capsys):
-    module = types.ModuleType("affordplan.robustness")
+    module = types.ModuleType("affordplan.app.robustness")
 
     def register_cli(bench_sub):
         p = bench_sub.add_parser("robustness", help="fake", epilog="example:\n  affordplan bench robustness")
         p.set_defaults(func=lambda args: print("robustness ran") or 0)
 
     module.register_cli = register_cli
-    monkeypatch.setitem(sys.modules, "affordplan.robustness", module)
-    monkeypatch.setattr("affordplan.robustness", module, raising=False)
+    monkeypatch.setitem(sys.modules, "affordplan.app.robustness", module)
+    monkeypatch.setattr("affordplan.app.robustness", module, raising=False)
     assert cli.main(["bench", "robustness"]) == 0
     assert "robustness ran" in capsys.readouterr().out
 
@@ -233,14 +233,14 @@ def test_write_video_falls_back_to_gif_without_ffmpeg(tmp_path, monkeypatch):
     def no_ffmpeg(*args, **kwargs):
         raise ImportError("no module named imageio_ffmpeg")
 
-    monkeypatch.setattr("affordplan.video._write_mp4", no_ffmpeg)
+    monkeypatch.setattr("affordplan.app.video._write_mp4", no_ffmpeg)
     with pytest.warns(UserWarning, match="writing a GIF instead"):
         path = write_video(_frames(3), tmp_path / "v.mp4", fps=5)
     assert path == tmp_path / "v.gif" and Image.open(path).n_frames == 3
 
 
 def test_viewer_without_a_display_carries_on_headless(monkeypatch):
-    from affordplan.viewer import open_viewer
+    from affordplan.app.viewer import open_viewer
 
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
@@ -281,7 +281,7 @@ def test_a_finished_run_exits_0_and_check_makes_a_missed_goal_exit_1(monkeypatch
         seen.append(kwargs)
         return types.SimpleNamespace(success=False)
 
-    monkeypatch.setattr("affordplan.demo.run_demo", fake_run_demo)
+    monkeypatch.setattr("affordplan.app.demo.run_demo", fake_run_demo)
     assert cli.main(["demo"]) == 0
     assert cli.main(["demo", "--check", "--sim", "finger", "--no-video", "--weights-dir", "cand"]) == 1
     assert seen[0]["sim"] == "arm" and seen[0]["max_primitives"] == 30 and seen[0]["video"]
@@ -290,10 +290,10 @@ def test_a_finished_run_exits_0_and_check_makes_a_missed_goal_exit_1(monkeypatch
 
 
 def test_a_scene_runs_the_skills_of_a_weights_folder(tmp_path):
-    from affordplan.demo import run_scene
-    from primitives.success import WEIGHTS_DIR
+    from affordplan.app.demo import run_scene
+    from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
-    kept = WEIGHTS_DIR / "candidates" / "push_0.18"
+    kept = Path(__file__).resolve().parents[1] / "candidates" / "push_0.18"
     lines: list[str] = []
     run = run_scene(demo_scene(), tmp_path, sim="finger", max_primitives=1, video=False, progress=False,
                     echo=lines.append, weights_dir=kept)
@@ -339,7 +339,7 @@ def test_bench_query_times_each_rater_of_each_skill(capsys):
 
 
 def test_bench_sim2sim_compares_identical_primitives():
-    from affordplan.bench import bench_sim2sim
+    from affordplan.app.bench.primitive import bench_sim2sim
 
     r = bench_sim2sim("cube", n=4, progress=False)
     assert r.compared + r.skipped == 4
@@ -350,7 +350,7 @@ def test_bench_sim2sim_compares_identical_primitives():
 
 @pytest.mark.parametrize("max_primitives", [0, 1.5, True])
 def test_run_scene_refuses_a_primitive_budget_that_is_not_a_whole_number(max_primitives, tmp_path):
-    from affordplan.demo import run_scene
+    from affordplan.app.demo import run_scene
 
     with pytest.raises(InputError, match="max_primitives must be a whole number >= 1"):
         run_scene(demo_scene(), tmp_path, max_primitives=max_primitives, video=False, progress=False)
@@ -375,7 +375,7 @@ def test_bench_query_times_a_candidate_folder_and_refuses_a_missing_one(capsys, 
 def test_bench_query_puts_the_thread_count_back_when_it_refuses_a_folder(tmp_path):
     import torch
 
-    from primitives.querybench import bench_queries
+    from affordplan.app.bench.query import bench_queries
     from primitives.skills import WEIGHTS_DIR
 
     for name in ("spin.pt", "spin_success.pt", "push.pt"):  # spin loads (and caps the threads); push has no model
@@ -392,7 +392,7 @@ def test_bench_query_puts_the_thread_count_back_when_it_refuses_a_folder(tmp_pat
 
 @pytest.mark.slow
 def test_bench_query_interleaves_the_skills_in_rounds(monkeypatch):
-    import primitives.querybench as qb
+    import affordplan.app.bench.query as qb
 
     order = []
     real = qb.time_calls

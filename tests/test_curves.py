@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from affordplan.errors import InputError
-from primitives import curves
-from primitives.curves import plot_curves, read_log, thousands
+from primitives.research import curves
+from primitives.research.curves import plot_curves, read_log, thousands
 
 HEADER = "step,updates,minutes,success_recent,reward_recent,critic_loss,actor_loss,invalid,steps_per_s,rss_mb_total\n"
 

@@ -15,8 +15,8 @@ import pytest
 import torch
 
 import affordplan as ap
-from affordplan.bench import random_primitive
-from primitives.evaluate import evaluate, load_policy
+from affordplan.app.bench.primitive import random_primitive
+from primitives.training.evaluate import evaluate, load_policy
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -5,8 +5,8 @@ import pytest
 import torch
 
 from affordplan.errors import InputError
-from primitives import success
 from primitives.ensemble import StackedEnsemble
+from primitives.training import success
 
 
 @pytest.mark.parametrize("members,n_decision,batch,encoder", [(1, 13, 1, "cloud"), (5, 14, 1, "cloud"),

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from primitives.evaluate import evaluate, load_policy
-from primitives.frame_ceiling import frame_ceiling, main
 from primitives.frames import load_frame_search
+from primitives.research.frame_ceiling import frame_ceiling, main
+from primitives.training.evaluate import evaluate, load_policy
 
 
 @pytest.mark.slow
@@ -52,7 +52,7 @@ def test_the_command_prints_the_figures_and_refuses_bad_input(tmp_path, capsys):
 
 
 def test_within_start_auroc_counts_only_starts_with_mixed_outcomes():
-    from primitives.frame_ceiling import FrameCeiling, StartOptions
+    from primitives.research.frame_ceiling import FrameCeiling, StartOptions
 
     def start(success, rating):
         n = len(success)

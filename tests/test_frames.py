@@ -10,7 +10,6 @@ import affordplan as ap
 from affordplan.errors import InputError
 from primitives import params as skill_params
 from primitives import rewards, weights_file
-from primitives.env import observation, observe_cloud, skill_observation
 from primitives.frames import (
     MIRROR_Y,
     FrameSearch,
@@ -20,6 +19,7 @@ from primitives.frames import (
     select_frame,
     stand_in_requests,
 )
+from primitives.training.env import observation, observe_cloud, skill_observation
 
 
 def test_each_request_leaves_its_own_frames_free():
@@ -177,7 +177,7 @@ def test_a_skill_with_frame_search_acts_in_its_likeliest_frame():
     best = search.frames("spin", params)[int(np.argmax(ratings))]
     assert np.allclose(chosen.A_frame_world, best @ seen.A_frame_world)
     contact, motion = skill.act(fresh(), params)
-    from primitives.evaluate import greedy_action
+    from primitives.training.evaluate import greedy_action
 
     idx, m, _ = greedy_action(skill.model, chosen.obs)
     assert np.allclose(contact, chosen.points[idx]) and np.allclose(motion, chosen.motion_to_world(m))
@@ -190,7 +190,7 @@ def test_a_skill_with_frame_search_acts_in_its_likeliest_frame():
 @pytest.mark.parametrize("name", ["push", "roll", "spin"])
 def test_the_shipped_skills_search_the_frames_shipped_beside_them(name):
     from primitives import load_skill
-    from primitives.success import WEIGHTS_DIR
+    from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
     shipped = FrameSearch.load(WEIGHTS_DIR / f"{name}_frames.json")
     assert load_skill(name).frame_search == shipped
@@ -214,8 +214,9 @@ def test_a_searched_success_model_rates_the_searched_skill_from_the_goal_frame(t
     import torch
     from scipy.special import expit
 
-    from primitives import load_skill, success
+    from primitives import load_skill
     from primitives.skills import Skill, shipped_frame_search
+    from primitives.training import success
 
     net = success.SuccessNet()
     with torch.no_grad():  # every member answers logit 0, the Platt scaling turns it into sigmoid(2)
@@ -248,7 +249,8 @@ def test_a_searched_success_model_rates_the_searched_skill_from_the_goal_frame(t
 def test_the_shipped_skills_rate_with_their_shipped_searched_success_model(name):
 
     from primitives import load_skill
-    from primitives.success import WEIGHTS_DIR, load_success_net
+    from primitives.success_model import load_success_net
+    from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
     skill = load_skill(name)
     assert skill.searched_model is not None
@@ -281,7 +283,7 @@ def test_a_skill_acting_as_a_stand_in_is_judged_by_the_seeds_objective():
 
 
 def test_evaluation_with_stand_ins_counts_the_trials_acted_as_one():
-    from primitives.evaluate import evaluate, load_policy
+    from primitives.training.evaluate import evaluate, load_policy
 
     model = load_policy(None, "push")
     search = FrameSearch(12, True, stand_ins=24)

@@ -10,9 +10,9 @@ from scipy.spatial.transform import Rotation
 
 from affordplan.sim.simulator import Outcome
 from primitives import rewards
-from primitives.env import EnvConfig, PrimitiveEnv, observe_cloud
-from primitives.hindsight import achieved, relabel
-from primitives.train import TrainConfig, train
+from primitives.training.env import EnvConfig, PrimitiveEnv, observe_cloud
+from primitives.training.hindsight import achieved, relabel
+from primitives.training.train import TrainConfig, train
 
 
 def _start(skill: str, params):
@@ -119,7 +119,7 @@ def test_training_with_hindsight_stores_copies_but_counts_primitives(tmp_path):
                       learning_starts=20, replay_size=1000, n_points=64, checkpoint_minutes=60.0, p_params=0.85,
                       hindsight=True)
     summary = train(cfg, progress=False)
-    from primitives import checkpoint as ckpt
+    from primitives.training import checkpoint as ckpt
 
     saved = ckpt.load(tmp_path / "checkpoint.pt")
     assert summary["steps"] == saved["state"]["global_step"] == 60

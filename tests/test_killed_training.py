@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 import torch
 
-from primitives import checkpoint as ckpt
-from primitives import killtest
-from primitives import train as train_mod
+from primitives.research import killtest
+from primitives.training import checkpoint as ckpt
+from primitives.training import train as train_mod
 
 
 @pytest.mark.slow
@@ -58,7 +58,7 @@ def test_resume_from_a_damaged_checkpoint_is_a_clear_error(tmp_path, capsys, dam
 
 _WRITER = textwrap.dedent("""
     import sys, torch
-    from primitives import checkpoint as ckpt
+    from primitives.training import checkpoint as ckpt
     path, i = sys.argv[1], 0
     while True:
         i += 1

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from primitives.neighbours import CONTACT_M, MOTION_RAD, neighbour_decisions, surface_tangent
+from primitives.training.neighbours import CONTACT_M, MOTION_RAD, neighbour_decisions, surface_tangent
 
 
 def test_the_four_neighbours_turn_the_motion_and_slide_the_contact():

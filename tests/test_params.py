@@ -130,7 +130,7 @@ def test_goal_frame_makes_each_request_canonical():
 
 def test_goal_frame_motion_reaches_the_world():
     """A goal-frame push along +x, from the point the frame puts last along x, moves the cube along the direction."""
-    from primitives.env import skill_observation
+    from primitives.training.env import skill_observation
 
     sim = ap.Simulator(ap.load_object("cube"), seed=0, sensor="surface")  # frames, not sensing, are tested here
     sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)

@@ -5,6 +5,7 @@ asks for, or fail on purpose), so that these tests check the planner, not the le
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -537,7 +538,7 @@ def test_bench_tasks_can_be_solved_in_principle():
     """Free start, goal free at its asked yaw, goal state reachable by rolls: no task is lost before it starts."""
     import networkx as nx
 
-    from planner.bench import make_task
+    from affordplan.app.bench.plan import make_task
     from planner.graph import RestingStateGraph
 
     rng = np.random.default_rng(0)
@@ -553,7 +554,7 @@ def test_bench_tasks_can_be_solved_in_principle():
 
 
 def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
-    from planner.bench import OBJECTS_PER_SEED, bench_plan, make_task
+    from affordplan.app.bench.plan import OBJECTS_PER_SEED, bench_plan, make_task
 
     _, obj = make_task(np.random.default_rng(3), OBJECTS_PER_SEED * 3 + 7)
     assert obj.name.startswith(f"test_{OBJECTS_PER_SEED * 3 + 7}_")
@@ -564,8 +565,8 @@ def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
 def test_bench_runs_chosen_tasks_of_the_seed_s_draw_and_logs_their_executions():
     """``only=[3]`` runs the task a whole run meets fourth (tasks are drawn in order), and the log shows its plan
     and each executed primitive with the resting states it went between."""
+    from affordplan.app.bench.plan import OBJECTS_PER_SEED, _describe, bench_plan, make_task
     from affordplan.errors import InputError
-    from planner.bench import OBJECTS_PER_SEED, _describe, bench_plan, make_task
 
     rng = np.random.default_rng(2)
     task = [make_task(rng, OBJECTS_PER_SEED * 2 + i)[0] for i in range(4)][3]
@@ -585,8 +586,8 @@ def test_bench_runs_chosen_tasks_of_the_seed_s_draw_and_logs_their_executions():
 def test_bench_draws_rerun_the_same_tasks_with_other_random_numbers():
     """``draw=0`` keeps the seeds the bench always used (``seed + task``); each other draw gives every task its own
     seed, and runs the very same task (object, scene, start, goal)."""
+    from affordplan.app.bench.plan import bench_plan, task_seed
     from affordplan.errors import InputError
-    from planner.bench import bench_plan, task_seed
 
     assert [task_seed(3, i) for i in range(3)] == [3, 4, 5] and task_seed(3, None) == 3
     seeds = {task_seed(s, i, d) for s in range(3) for i in [None, *range(50)] for d in (1, 2)}
@@ -615,7 +616,7 @@ def test_the_step_log_names_the_resting_states_a_primitive_went_between():
 
 
 def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
-    from planner.bench import RARE_GOAL_STATE, BenchReport, TaskResult
+    from affordplan.app.bench.plan import RARE_GOAL_STATE, BenchReport, TaskResult
 
     def result(ok, p_goal, missed=""):
         return TaskResult("affordplan", "open", ok, 0.1, 5, 1, "", p_goal, missed=missed)
@@ -670,9 +671,8 @@ def test_a_goal_free_only_in_a_narrow_band_of_yaws_is_accepted_and_reached():
 
 def test_a_predictor_loads_a_weights_folder_or_takes_skills_not_both(cube):
     from planner.predict import Predictor
-    from primitives.success import WEIGHTS_DIR
 
-    kept = WEIGHTS_DIR / "candidates" / "push_0.18"  # push only, fitted before the lever arm
+    kept = Path(__file__).resolve().parents[1] / "candidates" / "push_0.18"  # push only, fitted before the lever arm
     predictor = Predictor(cube, weights_dir=kept)
     assert predictor.skills["push"].success_model.net.n_decision == 13
     assert Predictor(cube).skills["push"].success_model.net.n_decision == 14

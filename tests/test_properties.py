@@ -13,8 +13,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import affordplan as ap
+from affordplan.app.scene_file import load_scene, parse_scene
 from affordplan.errors import AffordplanError
-from affordplan.scene_file import load_scene, parse_scene
 
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
 
@@ -109,7 +109,7 @@ def test_random_scene_files(tmp_path_factory, data, suffix):
                                       "nan", "mug", "x.txt", "--size", "0", "abc", "--state", "99"]),
                      min_size=1, max_size=6))
 def test_command_lines_exit_cleanly(tmp_path_factory, argv, capsys):
-    from affordplan.cli import main
+    from affordplan.app.cli import main
 
     folder = tmp_path_factory.mktemp("cli")
     argv = [a if a != "x.txt" else str(folder / "x.txt") for a in argv]

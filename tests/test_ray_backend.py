@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 import torch
 
-from primitives import checkpoint as ckpt
 from primitives import weights_file
-from primitives.compare_backends import Proportions
-from primitives.env import EnvConfig
 from primitives.networks import HybridActorCritic
-from primitives.rollouts import Exploration, LocalWorkers, RayWorkers, worker_seed
-from primitives.train import TrainConfig, main, train
+from primitives.research.compare_backends import Proportions
+from primitives.training import checkpoint as ckpt
+from primitives.training.env import EnvConfig
+from primitives.training.rollouts import Exploration, LocalWorkers, RayWorkers, worker_seed
+from primitives.training.train import TrainConfig, main, train
 
 ray = pytest.importorskip("ray")
 

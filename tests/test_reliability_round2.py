@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import affordplan as ap
-from affordplan.cli import main
+from affordplan.app.cli import main
 from affordplan.errors import GoalError, InputError, MeshError
 
 

@@ -8,7 +8,7 @@ import json
 import pytest
 
 import affordplan as ap
-from affordplan import robustness
+from affordplan.app import robustness
 from affordplan.errors import InputError
 
 GUARDS = {"nan", "unstable", "left_workspace", "speed", "sank", "off_table"}  # affordplan.sim.guards

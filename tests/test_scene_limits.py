@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from affordplan.app.scene_file import load_scene
 from affordplan.errors import InputError
-from affordplan.scene_file import load_scene
 
 VALID = "object: cube\nstart: {xy: [0.5, 0.0]}\ngoal: {xy: [0.6, 0.0]}\n"
 

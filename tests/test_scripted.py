@@ -12,11 +12,11 @@ import torch
 import affordplan as ap
 from affordplan.errors import InputError
 from primitives import rewards
-from primitives.env import EnvConfig, PrimitiveEnv, skill_observation
 from primitives.networks import HybridActorCritic
-from primitives.rollouts import Exploration, act
-from primitives.scripted import scripted_push
-from primitives.train import TrainConfig, check_config
+from primitives.training.env import EnvConfig, PrimitiveEnv, skill_observation
+from primitives.training.rollouts import Exploration, act
+from primitives.training.scripted import scripted_push
+from primitives.training.train import TrainConfig, check_config
 
 
 def _cube_env(p_params: float, seed: int = 0) -> PrimitiveEnv:
@@ -39,7 +39,7 @@ def test_an_asked_direction_is_pushed_along_from_the_face_against_it():
 def test_scripted_pushes_move_a_square_on_cube_along_the_asked_direction(cube):
     """Physics outcome: a cube with a face within 10 deg of square to the asked direction is pushed 4-9 cm along
     it, < 1 cm across, and straight (< 5 deg) in most trials: the 256-point cloud leaves the contact up to ~2 cm
-    off the centre line, which turns the cube (module docstring of primitives.ceiling)."""
+    off the centre line, which turns the cube (module docstring of primitives.research.ceiling)."""
     sim = ap.Simulator(cube, seed=0, sensor="surface")  # the scripted rule's geometry, on the exact surface
     rng = np.random.default_rng(0)
     successes = 0

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from affordplan.errors import InputError
-from primitives.frame_ceiling import frame_ceiling
-from primitives.sensitivity import VARIANTS, Sensitivity, StartDecisions, main, sensitivity
+from primitives.research.frame_ceiling import frame_ceiling
+from primitives.research.sensitivity import VARIANTS, Sensitivity, StartDecisions, main, sensitivity
 
 
 def test_the_base_outcomes_are_the_frame_ceilings_and_zero_sized_variants_repeat_them():

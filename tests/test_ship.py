@@ -1,4 +1,5 @@
-"""Shipping a candidate set (primitives.ship): the old files are kept, the new ones copied with their provenance
+"""Shipping a candidate set (primitives.research.ship):
+the old files are kept, the new ones copied with their provenance
 relabelled and their weights untouched, and a set fitted with other files is refused before anything moves."""
 
 import hashlib
@@ -11,8 +12,10 @@ import torch
 
 from affordplan.errors import InputError
 from primitives import load_skill, weights_file
-from primitives.ship import main, plan_ship, ship
-from primitives.success import WEIGHTS_DIR
+from primitives.research.ship import main, plan_ship, ship
+from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
+
+CANDIDATES = Path(__file__).resolve().parents[1] / "candidates"
 
 CORE = ("push.pt", "push_success.pt", "push_frames.json", "push_success_searched.pt")
 
@@ -42,7 +45,7 @@ def layout(tmp_path):
     for name in CORE + ("push_log.csv",):
         shutil.copy2(WEIGHTS_DIR / name, weights / name)
     for name in CORE + ("push.eval_seed7.json",):
-        shutil.copy2(WEIGHTS_DIR / "candidates" / "push_0.16" / name, cand / name)
+        shutil.copy2(CANDIDATES / "push_0.16" / name, cand / name)
     runs = {"policy": "runs/p/policy.pt", "model": "runs/s/success.pt", "frames": "runs/f/frames.json"}
     for role, own in (("policy", "push.pt"), ("model", "push_success.pt"), ("frames", "push_frames.json")):
         (base / runs[role]).parent.mkdir(parents=True)
@@ -63,7 +66,7 @@ def test_shipping_keeps_the_old_files_and_relabels_the_new(layout):
     assert len(plan.checked) == 6 and not plan.unchecked  # policy x3, model x2, frames x1
     ship(plan, "9.9.9")
 
-    kept = weights / "candidates" / "push_old"
+    kept = base / "candidates" / "push_old"
     assert {p.name: digest(p) for p in kept.iterdir()} == old  # moved whole, bytes unchanged
     assert not (weights / "push_log.csv").exists()  # a file of the old set that the new one lacks is not left behind
     assert digest(weights / "push.pt") == digest(cand / "push.pt")  # the policy is copied as it is
@@ -100,7 +103,7 @@ def test_run_paths_absent_here_are_reported_not_refused(layout, capsys):
     assert main(["push", "--from", str(cand), "--keep", "push_old", "--weights-dir", str(weights), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "not checked (absent here)" in out and "dry run: nothing changed" in out
-    assert not (weights / "candidates").exists()
+    assert not (base / "candidates").exists() and not (weights / "candidates").exists()
 
 
 @pytest.mark.parametrize("case", ["keep exists", "no success model", "bad keep name", "unknown skill", "same folder"])
@@ -108,7 +111,7 @@ def test_sets_that_cannot_ship_are_refused(layout, case):
     weights, cand, base, _ = layout
     skill, keep, source = "push", "push_old", cand
     if case == "keep exists":
-        (weights / "candidates" / "push_old").mkdir(parents=True)
+        (base / "candidates" / "push_old").mkdir(parents=True)
     elif case == "no success model":
         (cand / "push_success.pt").unlink()
     elif case == "bad keep name":

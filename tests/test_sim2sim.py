@@ -1,6 +1,6 @@
 """Skills run by the finger and by the arm from the same draws."""
 
-from primitives.sim2sim import skill_sim2sim
+from primitives.research.sim2sim import skill_sim2sim
 
 
 def test_both_sims_run_every_draw_and_the_report_counts_them():

@@ -5,9 +5,10 @@ import pytest
 import torch
 
 from affordplan.errors import InputError
-from primitives import success, weights_file
+from primitives import weights_file
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
+from primitives.training import success
 
 
 def test_metrics_on_known_values():

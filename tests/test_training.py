@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 import torch
 
-from primitives import checkpoint as ckpt
 from primitives import weights_file
-from primitives.env import EnvConfig, PrimitiveEnv
-from primitives.evaluate import evaluate, greedy_action, load_policy
 from primitives.networks import HybridActorCritic, choose_contact
-from primitives.replay import ReplayBuffer
-from primitives.train import TrainConfig, bf16_is_fast, train, update
+from primitives.training import checkpoint as ckpt
+from primitives.training.env import EnvConfig, PrimitiveEnv
+from primitives.training.evaluate import evaluate, greedy_action, load_policy
+from primitives.training.replay import ReplayBuffer
+from primitives.training.train import TrainConfig, bf16_is_fast, train, update
 
 
 def test_maps_are_per_point_and_permutation_equivariant():
@@ -148,7 +148,7 @@ def test_resume_lets_go_of_the_loaded_checkpoint(tmp_path, monkeypatch):
     import gc
     import weakref
 
-    import primitives.train as train_mod
+    import primitives.training.train as train_mod
 
     train(_cube_config(tmp_path, 120), progress=False)
     held, load = [], ckpt.load
@@ -313,7 +313,7 @@ def test_shipped_weights_load_offline_and_act(name):
 def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field, value, words):
 
     from affordplan.errors import InputError
-    from primitives.train import TrainConfig, check_config, train
+    from primitives.training.train import TrainConfig, check_config, train
 
     cfg = replace(TrainConfig(out=str(tmp_path / "run")), **{field: value})
     with pytest.raises(InputError) as info:
@@ -325,7 +325,7 @@ def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field,
 
 
 def test_the_cli_reports_bad_settings_as_usage_errors(capsys):
-    from primitives.train import main
+    from primitives.training.train import main
 
     with pytest.raises(SystemExit) as info:
         main(["push", "--p-params", "2", "--out", "/nonexistent/run"])
@@ -334,7 +334,7 @@ def test_the_cli_reports_bad_settings_as_usage_errors(capsys):
 
 
 def test_resume_without_a_checkpoint_says_it_starts_a_new_run(tmp_path, capsys):
-    from primitives.train import TrainConfig, train
+    from primitives.training.train import TrainConfig, train
 
     cfg = TrainConfig(primitive="push", steps=2, workers=0, out=str(tmp_path), objects=("cube",), n_points=64,
                       replay_size=64, checkpoint_minutes=60.0)

@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from affordplan.errors import InputError
-from primitives import checkpoint as ckpt
-from primitives.train import RunLock, TrainConfig, main, train
+from primitives.training import checkpoint as ckpt
+from primitives.training.train import RunLock, TrainConfig, main, train
 
 
 def _config(out, steps=40, **kw) -> TrainConfig:
@@ -76,7 +76,7 @@ def test_resume_drops_log_rows_written_after_the_checkpoint(tmp_path):
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_a_stopped_run_saves_its_checkpoint_and_resumes(tmp_path, sig):
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "primitives.train", "push", "--objects", "cube", "--workers", "1", "--steps",
+    cmd = [sys.executable, "-m", "primitives.training.train", "push", "--objects", "cube", "--workers", "1", "--steps",
            "100000", "--n-points", "32", "--replay-size", "500", "--learning-starts", "16", "--out", str(out)]
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]), PYTHONUNBUFFERED="1")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, text=True,

@@ -12,7 +12,7 @@ from affordplan.errors import WeightsError
 from primitives import weights_file
 from primitives.networks import HybridActorCritic
 from primitives.policy import load_policy
-from primitives.success import load_success_net
+from primitives.training.success import load_success_net
 
 
 class _Payload:

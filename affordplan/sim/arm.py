@@ -28,6 +28,7 @@ import mujoco
 import numpy as np
 
 from affordplan.errors import ReachabilityError
+from affordplan.robot import FINGERTIP_REACH, TIP_RADIUS  # noqa: F401 (re-exported)
 from affordplan.world import Box
 
 JOINTS = tuple(f"joint{i}" for i in range(1, 8))
@@ -41,10 +42,6 @@ HOME = (0.0, -0.55, 0.0, -2.35, 0.0, 1.8, 0.785)  # fingertip above the near wor
 KP, KV = 20000.0, 200.0
 IK_DT = 0.02  # seconds: IK at 50 Hz
 FINGERTIP_SITE = "fingertip"
-TIP_RADIUS = 0.008
-# Metres from the base (the world origin) within which :meth:`ArmIK.check_reachable` accepts a fingertip
-# target pointing down: measured 0.814-0.816 m at heights 2-10 cm and headings 0-40 deg, from HOME.
-FINGERTIP_REACH = 0.815
 # The fingers are 13 cm long (the Panda's are 5 cm): a pushing tool, so the hand stays above objects
 # up to 12 cm tall while the fingertip pushes low on them.
 FINGER_LENGTH = 0.132

@@ -24,9 +24,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from affordplan.errors import InputError
+from affordplan.robot import TABLE_CONTACT_HEIGHT
 
 SENSORS = ("cameras", "surface")
-TABLE_CONTACT_HEIGHT = 0.003  # points lower than this touch the table and are left out (no fingertip reaches), metres
 NORMAL_NEIGHBOURS = 12  # points in each normal's PCA neighbourhood
 
 

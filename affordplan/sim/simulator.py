@@ -13,7 +13,6 @@ updated and the guards run once per chunk (every 20 ms), so no Python runs per p
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -26,6 +25,7 @@ from affordplan.checks import as_finite, as_seed, as_vector, as_whole, describe
 from affordplan.errors import InputError, PerceptionError, ReachabilityError
 from affordplan.geometry import check_pose, make_pose, relative_rotation, transform_points
 from affordplan.objects.model import ObjectModel
+from affordplan.robot import Protocol
 from affordplan.sim.arm import HOME, ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
 from affordplan.sim.pushers import ArmPusher, FingerPusher
@@ -38,29 +38,6 @@ OVERLAP_TOLERANCE = 0.002  # metres of penetration into an obstacle that reset()
 MAX_CLOUD_POINTS = 100_000  # most points one cloud may ask for
 CHUNK_STEPS = 10  # physics steps between target updates and guard checks (20 ms)
 __all__ = ["CHUNK_STEPS", "TABLE_CONTACT_HEIGHT", "Outcome", "Protocol", "SimState", "Simulator"]
-
-
-@dataclass(frozen=True)
-class Protocol:
-    """Timing and geometry of one primitive (SI units)."""
-
-    standoff: float = 0.04  # pre-contact distance along the normal
-    mid_standoff: float = 0.02
-    approach_time: float = 0.1  # per approach segment, seconds
-    motion_step: float = 0.03  # target displacement per control step and unit of motion
-    motion_steps: int = 3
-    motion_step_time: float = 0.5
-    retract_height: float = 0.05
-    retract_time: float = 0.1
-    settle_time_max: float = 2.0
-    settle_linear_speed: float = 0.005  # m/s
-    settle_angular_speed: float = 0.05  # rad/s
-    settle_chunks: int = 5  # consecutive still chunks that count as settled
-    approach_position_tolerance: float = 0.02
-    approach_tilt_tolerance: float = math.radians(5.0)
-    approach_disturbance: float = 0.005  # object displacement before contact that fails approach
-    approach_disturbance_angle: float = math.radians(3.0)
-    transit_clearance: float = 0.12  # arm transit height above the tallest obstacle or the object
 
 
 @dataclass

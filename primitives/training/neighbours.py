@@ -1,10 +1,10 @@
 """A decision's neighbours: the same push with its motion turned a little, or from a contact moved a little.
 
 A primitive's decision is a contact on the object's surface and a motion (world frame). Whether it succeeds can
-hang on millimetres and degrees (``python -m primitives.sensitivity``), while the share of its neighbours that
+hang on millimetres and degrees (``python -m primitives.research.sensitivity``), while the share of its neighbours that
 succeed ranks one start's options much better than any success model yet: it is the part of the outcome a model
 of the cloud and the decision can hope to predict. Both the sensitivity benchmark and the success models' smoothed
-labels (:func:`primitives.success.collect_contrast` with ``neighbours``) execute these variants
+labels (:func:`primitives.training.success.collect_contrast` with ``neighbours``) execute these variants
 (:func:`neighbour_outcomes`):
 
 - **motion +-a**: the same contact, the motion turned by ``a`` about the world vertical;

@@ -1,7 +1,7 @@
 """How often can a push succeed at all? The best of scripted pushes, with privileged knowledge.
 
-    python -m primitives.ceiling --starts 100 --params random
-    python -m primitives.ceiling --starts 100 --params none --json
+    python -m primitives.research.ceiling --starts 100 --params random
+    python -m primitives.research.ceiling --starts 100 --params none --json
 
 A push-straight must move the object >= 5 cm and turn it < 5 deg. A point fingertip pushing a flat face
 turns the object unless the push line passes within a few millimetres of the centre of mass (a 10 cm
@@ -10,7 +10,7 @@ ellipsoids roll whichever way they are pushed. This benchmark measures how much 
 family any push can move straight, so that a policy's success reads against what the pusher and the
 protocol allow.
 
-For each start of the evaluation (:func:`primitives.evaluate.evaluate`'s starts: the same objects,
+For each start of the evaluation (:func:`primitives.training.evaluate.evaluate`'s starts: the same objects,
 states and poses for the same ``--seed``), the simulator is restored to the start before each of
 ``CANDIDATES`` scripted pushes (that many for each aim):
 
@@ -47,10 +47,10 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
 from affordplan.sim.simulator import Simulator
-from primitives.env import PrimitiveEnv
-from primitives.evaluate import greedy_action, held_out_config, load_policy
-from primitives.neighbours import judged_execution
-from primitives.scripted import facing_and_offset
+from primitives.training.env import PrimitiveEnv
+from primitives.training.evaluate import greedy_action, held_out_config, load_policy
+from primitives.training.neighbours import judged_execution
+from primitives.training.scripted import facing_and_offset
 
 CLOUD_POINTS = 2048
 HEIGHT_BANDS = ((0.05, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.95))  # fractions of the object's height
@@ -202,9 +202,9 @@ def push_ceiling(starts: int = 100, params: str = "random", seed: int = 1234, we
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m primitives.ceiling", description=__doc__.split("\n\n")[0],
-        epilog="examples:\n  python -m primitives.ceiling --starts 100 --params random\n"
-               "  python -m primitives.ceiling --starts 100 --params none --json",
+        prog="python -m primitives.research.ceiling", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n  python -m primitives.research.ceiling --starts 100 --params random\n"
+               "  python -m primitives.research.ceiling --starts 100 --params none --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--starts", type=int, default=100, help="held-out starts (default: 100)")
     p.add_argument("--params", choices=["none", "random"], default="random",
@@ -228,7 +228,7 @@ def main(argv: list[str] | None = None) -> int:
         result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json,
                               aims=tuple(math.radians(a) for a in args.aim_deg))
     except AffordplanError as exc:  # missing or broken weights, ...
-        print(f"primitives.ceiling: error: {exc}", file=sys.stderr)
+        print(f"primitives.research.ceiling: error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     return 0

@@ -1,6 +1,6 @@
 """Where the learner's transitions come from: rollout workers behind one small interface.
 
-A :class:`RolloutSource` runs K workers that each own a :class:`~primitives.env.PrimitiveEnv`, act
+A :class:`RolloutSource` runs K workers that each own a :class:`~primitives.training.env.PrimitiveEnv`, act
 with exploration (:func:`act`) using the latest weights the learner pushed, and hand back one-step
 transitions. Two implementations:
 
@@ -29,10 +29,10 @@ import numpy as np
 import torch
 
 from affordplan.errors import InputError
-from primitives.env import EnvConfig, PrimitiveEnv
-from primitives.hindsight import relabel
 from primitives.networks import HybridActorCritic, choose_contact
-from primitives.scripted import scripted_push
+from primitives.training.env import EnvConfig, PrimitiveEnv
+from primitives.training.hindsight import relabel
+from primitives.training.scripted import scripted_push
 
 # (observation (n_points, 9) float16, contact index, motion (3,) float32 in [-1, 1], reward, success, valid,
 #  relabelled: a hindsight copy of the primitive before it, not a primitive of its own)
@@ -47,16 +47,16 @@ class Exploration:
     temperature: float = 0.1  # softmax temperature over the critic map
     epsilon: float = 0.1  # share of uniformly drawn contacts
     motion_noise: float = 0.2  # std of the Gaussian noise on the chosen motion (motion units, [-1, 1])
-    p_scripted: float = 0.0  # push only: share of actions replaced by a scripted push (primitives.scripted)
-    hindsight: bool = False  # also send each primitive relabelled to other requests (primitives.hindsight)
+    p_scripted: float = 0.0  # push only: share of actions replaced by a scripted push (primitives.training.scripted)
+    hindsight: bool = False  # also send each primitive relabelled to other requests (primitives.training.hindsight)
 
 
 def act(model: HybridActorCritic, obs: np.ndarray, explore: Exploration, rng: np.random.Generator,
         gen: torch.Generator) -> tuple[int, np.ndarray]:
     """Exploring contact index and motion for one observation (greedy acting: evaluate.greedy_action).
 
-    With probability ``explore.p_scripted`` (push only; :func:`primitives.train.check_config` says so) the
-    action is :func:`primitives.scripted.scripted_push` instead; with 0 no extra random number is drawn,
+    With probability ``explore.p_scripted`` (push only; :func:`primitives.training.train.check_config` says so) the
+    action is :func:`primitives.training.scripted.scripted_push` instead; with 0 no extra random number is drawn,
     so runs without it are unchanged.
     """
     if explore.p_scripted > 0.0 and rng.random() < explore.p_scripted:

@@ -1,6 +1,6 @@
 """``affordplan demo`` and ``affordplan plan SCENE``: plan, execute in the arm sim, film, report.
 
-:func:`run_scene` takes a :class:`affordplan.scene_file.Scene`, plans with :func:`affordplan.plan`,
+:func:`run_scene` takes a :class:`affordplan.app.scene_file.Scene`, plans with :func:`affordplan.plan`,
 prints the plan, executes it closed-loop (``Plan.execute``, re-observing and replanning after every
 primitive) in a MuJoCo simulator with the 7-DOF arm (or the finger), and writes to ``out_dir``:
 
@@ -11,7 +11,7 @@ primitive) in a MuJoCo simulator with the 7-DOF arm (or the finger), and writes 
 - ``summary.json``: the scene, the plan, the execution log and the final errors.
 
 It prints honestly whether the goal was reached, with the position, yaw and resting-state errors.
-:func:`run_demo` runs the embedded demo scene (:data:`affordplan.scene_file.DEMO_SCENE`): the mug on
+:func:`run_demo` runs the embedded demo scene (:data:`affordplan.app.scene_file.DEMO_SCENE`): the mug on
 its side behind a wall with a gap, to be flipped upright, pushed through the gap and turned to 90 deg.
 """
 
@@ -28,14 +28,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from affordplan import versions
+from affordplan.app.scene_file import Scene, demo_scene
+from affordplan.app.video import FrameRecorder, chain_hooks, save_strip, write_video
 from affordplan.checks import require_whole
 from affordplan.errors import InputError
 from affordplan.geometry import transform_points
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
-from affordplan.scene_file import Scene, demo_scene
 from affordplan.sim.simulator import Outcome, Simulator
-from affordplan.video import FrameRecorder, chain_hooks, save_strip, write_video
 
 DEMO_MAX_PRIMITIVES = 30  # bounds the demo's time: ~1-3 s per arm primitive with frames on 2 cores
 END_HOLD_S = 1.0  # the video holds its last frame this long
@@ -162,7 +162,7 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
         progress: show a progress bar (primitives executed, frames rendered) on stderr.
         echo: where the report lines go.
         weights_dir: run the skills from this folder's files instead of the shipped ones, e.g. a candidate set
-            under ``primitives/weights/candidates/`` (:func:`primitives.skills.load_skills`; a skill without
+            under ``candidates/`` (:func:`primitives.skills.load_skills`; a skill without
             files there stays shipped).
 
     Raises:
@@ -213,7 +213,7 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
     recorder = FrameRecorder(simulator, width, height, camera, frame_interval) if video else None
     live = None
     if viewer:
-        from affordplan.viewer import open_viewer
+        from affordplan.app.viewer import open_viewer
 
         live = open_viewer(simulator, echo=echo)
     simulator.on_chunk = chain_hooks(recorder.on_chunk if recorder else None, live.on_chunk if live else None)

@@ -67,15 +67,15 @@ def _run_kwargs(args: argparse.Namespace) -> dict:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from affordplan.demo import run_demo
+    from affordplan.app.demo import run_demo
 
     run = run_demo(args.out, **_run_kwargs(args))
     return 1 if args.check and not run.success else 0
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
-    from affordplan.demo import run_scene
-    from affordplan.scene_file import load_scene
+    from affordplan.app.demo import run_scene
+    from affordplan.app.scene_file import load_scene
 
     scene = load_scene(args.scene)
     run = run_scene(scene, args.out or f"affordplan-plan/{scene.name}", **_run_kwargs(args))
@@ -85,9 +85,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 def _cmd_render(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from affordplan.app.render import render_states, save_states_picture, state_label
     from affordplan.errors import InputError
     from affordplan.objects.model import load_object
-    from affordplan.render import render_states, save_states_picture, state_label
 
     if args.out is not None and Path(args.out).suffix.lower() not in (".png", ".jpg", ".jpeg"):
         raise InputError(f"--out {args.out[:80]}: the picture is written as .png or .jpg")
@@ -103,7 +103,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_sim(args: argparse.Namespace) -> int:
-    from affordplan.bench import bench_sim
+    from affordplan.app.bench.primitive import bench_sim
 
     results = [bench_sim(name, args.n, pusher=args.pusher, seed=args.seed, progress=not args.json)
                for name in args.object]
@@ -117,12 +117,12 @@ def _cmd_bench_sim(args: argparse.Namespace) -> int:
 
 def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
     if args.skill:
-        from primitives.sim2sim import skill_sim2sim
+        from primitives.research.sim2sim import skill_sim2sim
 
         for skill in args.skill:
             print(skill_sim2sim(skill, args.n, seed=args.seed, progress=True).report())
         return 0
-    from affordplan.bench import bench_sim2sim
+    from affordplan.app.bench.primitive import bench_sim2sim
 
     for name in args.object:
         print(bench_sim2sim(name, args.n, seed=args.seed, progress=True).report())
@@ -130,7 +130,7 @@ def _cmd_bench_sim2sim(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_query(args: argparse.Namespace) -> int:
-    from primitives.querybench import bench_queries, report
+    from affordplan.app.bench.query import bench_queries, report
 
     rows = bench_queries(tuple(args.skill), repeats=args.repeats, batch=args.batch, seed=args.seed,
                          weights_dir=args.weights_dir, rounds=args.rounds)
@@ -139,7 +139,7 @@ def _cmd_bench_query(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_plan(args: argparse.Namespace) -> int:
-    from planner.bench import bench_plan
+    from affordplan.app.bench.plan import bench_plan
 
     log = (lambda text: print(text, file=sys.stderr, flush=True)) if args.log else None
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
@@ -184,7 +184,7 @@ def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_pr
                    help="seeds the planner and the point clouds (default: %(default)s)")
     p.add_argument("--weights-dir", default=None, metavar="DIR",
                    help="run the skills from this folder's files (laid out like primitives/weights/, e.g. a "
-                        "candidate set under primitives/weights/candidates/) instead of the shipped ones")
+                        "candidate set under candidates/) instead of the shipped ones")
     video = p.add_argument_group("video")
     video.add_argument("--no-video", "--no-render", dest="no_video", action="store_true",
                        help="skip rendering: only plan.png and summary.json are written")
@@ -260,13 +260,13 @@ def _nonnegative_int(text: str) -> int:
 
 
 def _register_robustness(bench_sub) -> None:
-    """``affordplan bench robustness ...`` when :mod:`affordplan.robustness` exists (it is optional)."""
+    """``affordplan bench robustness ...`` when :mod:`affordplan.app.robustness` exists (it is optional)."""
     import importlib
 
     try:
-        robustness = importlib.import_module("affordplan.robustness")
+        robustness = importlib.import_module("affordplan.app.robustness")
     except ModuleNotFoundError as exc:
-        if exc.name != "affordplan.robustness":  # it exists but needs something missing: say so
+        if exc.name != "affordplan.app.robustness":  # it exists but needs something missing: say so
             raise
         return
     robustness.register_cli(bench_sub)
@@ -421,7 +421,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "asks them, with the searched success model and with the frame search's own rating, on "
                           "1 and 2 torch threads; the skills' timings interleaved in rounds."),
         epilog="examples:\n  affordplan bench query\n  affordplan bench query --skill spin --repeats 300 --json\n"
-               "  affordplan bench query --skill spin --weights-dir primitives/weights/candidates/spin_cframe",
+               "  affordplan bench query --skill spin --weights-dir candidates/spin_cframe",
         formatter_class=_formatter,
     )
     bq.add_argument("--skill", nargs="+", default=["push", "spin", "roll"], choices=["push", "spin", "roll"],
@@ -446,7 +446,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="examples:\n  affordplan bench plan --tasks 50 --sim arm --seed 0\n"
                "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json\n"
                "  affordplan bench plan --seed 3 --task 22 42 --planner affordplan --log   # why they failed\n"
-               "  affordplan bench plan --planner affordplan --weights-dir primitives/weights/candidates/push_60\n"
+               "  affordplan bench plan --planner affordplan --weights-dir candidates/push_60\n"
                "  affordplan bench plan --seed 0 --planner affordplan --draw 1   # the same tasks, other random draws",
         formatter_class=_formatter,
     )
@@ -462,7 +462,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="print each task's first plan and step-by-step execution log (to stderr)")
     bp.add_argument("--weights-dir", default=None, metavar="DIR",
                     help="run the skills from this folder's files (laid out like primitives/weights/, e.g. "
-                         "primitives/weights/candidates/push_60) instead of the shipped ones; a skill without "
+                         "candidates/push_60) instead of the shipped ones; a skill without "
                          "files there stays shipped")
     bp.add_argument("--draw", type=_nonnegative_int, default=0, metavar="K",
                     help="run the same tasks with the planner's and the simulator's random numbers drawn afresh "

@@ -1,18 +1,18 @@
 """How much could a frame search gain? Every option it rates, executed from the same start.
 
-    python -m primitives.frame_ceiling spin --starts 100 --params random
-    python -m primitives.frame_ceiling push --starts 100 --params none --json --plot push_frame_ceiling.png
+    python -m primitives.research.frame_ceiling spin --starts 100 --params random
+    python -m primitives.research.frame_ceiling push --starts 100 --params none --json --plot push_frame_ceiling.png
 
 A frame search (:mod:`primitives.frames`) sees a start in every frame its request leaves free (and, for the
 seed's objective, as each stand-in request) and acts in the option its success model rates likeliest. For each
-start of the evaluation (:func:`primitives.evaluate.evaluate`'s starts for the same ``--seed``), this benchmark
+start of the evaluation (:func:`primitives.training.evaluate.evaluate`'s starts for the same ``--seed``), this benchmark
 restores the simulator to the start before executing the policy in *every* option, and reports the success of
 
 - **goal frame**: the policy as trained, no search;
 - **random option**: an option drawn at random (the mean over a start's options);
 - **critic's pick**: the option where the critic's value at its chosen contact is highest;
 - **search's pick**: the option the frame search acts in (the skill as shipped; the outcomes of
-  ``primitives.evaluate --frames`` on the same starts);
+  ``primitives.training.evaluate --frames`` on the same starts);
 - **best option**: some option succeeds, what a perfect ranking of the same options would reach;
 
 and how well the success model ranks one start's options: the **within-start AUROC** of the ratings (each
@@ -36,11 +36,11 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
-from primitives.env import PRIMITIVES, PrimitiveEnv
-from primitives.evaluate import greedy_action, held_out_config, load_policy
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
-from primitives.success import SuccessModel, auroc, load_success_net
+from primitives.training.env import PRIMITIVES, PrimitiveEnv
+from primitives.training.evaluate import greedy_action, held_out_config, load_policy
+from primitives.training.success import SuccessModel, auroc, load_success_net
 
 
 @dataclass(frozen=True)
@@ -171,8 +171,8 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
 
 def add_held_out_arguments(p: argparse.ArgumentParser) -> None:
     """The arguments of a benchmark that acts on the evaluation's held-out starts with a frame search (this one
-    and :mod:`primitives.sensitivity`): the skill, ``--starts``, ``--params``, ``--seed``, the files, ``--plot``
-    and ``--json``."""
+    and :mod:`primitives.research.sensitivity`): the skill, ``--starts``, ``--params``, ``--seed``, the files,
+    ``--plot`` and ``--json``."""
     p.add_argument("skill", choices=PRIMITIVES)
     p.add_argument("--starts", type=int, default=100, help="held-out starts (default: 100)")
     p.add_argument("--params", choices=["none", "random"], default="random",
@@ -187,9 +187,9 @@ def add_held_out_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m primitives.frame_ceiling", description=__doc__.split("\n\n")[0],
-        epilog="examples:\n  python -m primitives.frame_ceiling spin --starts 100 --params random\n"
-               "  python -m primitives.frame_ceiling push --starts 100 --params none --json",
+        prog="python -m primitives.research.frame_ceiling", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n  python -m primitives.research.frame_ceiling spin --starts 100 --params random\n"
+               "  python -m primitives.research.frame_ceiling push --starts 100 --params none --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_held_out_arguments(p)
     return p
@@ -205,7 +205,7 @@ def main(argv: list[str] | None = None) -> int:
         result = frame_ceiling(args.skill, args.starts, args.params, args.seed, args.weights, args.model,
                                args.frames, progress=not args.json)
     except AffordplanError as exc:  # missing or broken weights, an unreadable frames file, ...
-        print(f"primitives.frame_ceiling: error: {exc}", file=sys.stderr)
+        print(f"primitives.research.frame_ceiling: error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     if args.plot:

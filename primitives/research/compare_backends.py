@@ -1,11 +1,11 @@
 """Do the local and the Ray rollout backends train equally well? Same budget, same seeds, same test.
 
-    python -m primitives.compare_backends push --steps 1500 --seeds 3 --trials 200 \
+    python -m primitives.research.compare_backends push --steps 1500 --seeds 3 --trials 200 \
         --init primitives/weights/push.pt --out runs/compare_backends
 
 For each seed, trains one policy with ``--backend local`` and one with ``--backend ray`` (same step
 budget, same ``--workers``, same seed, hence the same worker seeds), then evaluates every policy
-greedily on the same held-out starts (:func:`primitives.evaluate.evaluate`: the held-out procedural
+greedily on the same held-out starts (:func:`primitives.training.evaluate.evaluate`: the held-out procedural
 objects, one evaluation seed). Reports, per backend, the greedy success pooled over seeds and the
 exploring success of the transitions collected during training, each with a two-sided
 two-proportion z-test and Fisher's exact test of "both backends succeed equally often".
@@ -32,11 +32,11 @@ import numpy as np
 import torch
 from scipy import stats
 
-from primitives import checkpoint as ckpt
-from primitives.env import PRIMITIVES
-from primitives.evaluate import evaluate, load_policy
-from primitives.rollouts import BACKENDS, connect_ray, import_ray
-from primitives.train import TrainConfig, train
+from primitives.training import checkpoint as ckpt
+from primitives.training.env import PRIMITIVES
+from primitives.training.evaluate import evaluate, load_policy
+from primitives.training.rollouts import BACKENDS, connect_ray, import_ray
+from primitives.training.train import TrainConfig, train
 
 
 @dataclass(frozen=True)
@@ -122,7 +122,8 @@ def compare(primitive: str, steps: int, seeds: int, trials: int, out: Path, work
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m primitives.compare_backends", description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m primitives.research.compare_backends",
+                                description=__doc__.split("\n\n")[0])
     d = TrainConfig()
     p.add_argument("primitive", choices=PRIMITIVES)
     p.add_argument("--steps", type=int, default=600, help="primitives per training run (default: %(default)s)")

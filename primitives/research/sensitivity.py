@@ -1,12 +1,13 @@
 """How sharp is success around the policy's decision? Each decision executed again, slightly changed.
 
-    python -m primitives.sensitivity spin --starts 100 --params random
-    python -m primitives.sensitivity push --starts 100 --params none --json --plot push_sensitivity.png
+    python -m primitives.research.sensitivity spin --starts 100 --params random
+    python -m primitives.research.sensitivity push --starts 100 --params none --json --plot push_sensitivity.png
 
 A frame search (:mod:`primitives.frames`) ranks one start's options by its success model, and
-``python -m primitives.frame_ceiling`` shows that a perfect ranking would gain much: the question this benchmark
-answers is whether the outcomes it would have to predict are predictable at all. For each held-out start
-(:func:`primitives.evaluate.evaluate`'s starts for the same ``--seed``) it draws ``--options`` of the options the
+``python -m primitives.research.frame_ceiling`` shows that a perfect ranking would gain much: the question this
+benchmark answers is whether the outcomes it would have to predict are predictable at all. For each held-out start
+(:func:`primitives.training.evaluate.evaluate`'s starts for the same ``--seed``) it
+draws ``--options`` of the options the
 shipped frame search rates, and executes the policy's decision in each from the start (**base**), then again:
 
 - **motion +-a**: the same contact, the motion turned by ``a`` (default 3 deg) about the vertical;
@@ -40,13 +41,13 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
-from primitives.env import PrimitiveEnv
-from primitives.evaluate import greedy_action, held_out_config, load_policy
-from primitives.frame_ceiling import add_held_out_arguments
 from primitives.frames import FrameSearch, load_frame_search
-from primitives.neighbours import CONTACT_M, MOTION_RAD, judged_execution, neighbour_outcomes
 from primitives.networks import HybridActorCritic
-from primitives.success import SuccessModel, auroc, load_success_net
+from primitives.research.frame_ceiling import add_held_out_arguments
+from primitives.training.env import PrimitiveEnv
+from primitives.training.evaluate import greedy_action, held_out_config, load_policy
+from primitives.training.neighbours import CONTACT_M, MOTION_RAD, judged_execution, neighbour_outcomes
+from primitives.training.success import SuccessModel, auroc, load_success_net
 
 VARIANTS = ("motion +a", "motion -a", "contact +d", "contact -d", "scene shift")
 _NEIGHBOURS = slice(0, 4)  # the decision variants of VARIANTS (not the scene shift)
@@ -55,8 +56,8 @@ _NEIGHBOURS = slice(0, 4)  # the decision variants of VARIANTS (not the scene sh
 @dataclass(frozen=True)
 class StartDecisions:
     """The drawn options of one start: ``row`` (each one's index in the start's options and frames, in the order
-    :mod:`primitives.frame_ceiling` lists them, ``(k,)``), ``rating`` (calibrated for its kind, ``(k,)``), the base
-    outcomes ``base (k,)`` and the variants' outcomes ``variants (k, len(VARIANTS))``."""
+    :mod:`primitives.research.frame_ceiling` lists them, ``(k,)``), ``rating`` (calibrated for its kind, ``(k,)``),
+    the base outcomes ``base (k,)`` and the variants' outcomes ``variants (k, len(VARIANTS))``."""
 
     row: np.ndarray
     rating: np.ndarray
@@ -204,9 +205,9 @@ def sensitivity(skill: str, starts: int = 100, params: str = "random", options: 
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m primitives.sensitivity", description=__doc__.split("\n\n")[0],
-        epilog="examples:\n  python -m primitives.sensitivity spin --starts 100 --params random\n"
-               "  python -m primitives.sensitivity push --starts 100 --params none --json",
+        prog="python -m primitives.research.sensitivity", description=__doc__.split("\n\n")[0],
+        epilog="examples:\n  python -m primitives.research.sensitivity spin --starts 100 --params random\n"
+               "  python -m primitives.research.sensitivity push --starts 100 --params none --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_held_out_arguments(p)
     p.add_argument("--options", type=int, default=3, help="options drawn per start (default: 3)")
@@ -225,7 +226,7 @@ def main(argv: list[str] | None = None) -> int:
                              np.radians(args.motion_deg), 1e-3 * args.contact_mm, args.weights, args.model,
                              args.frames, progress=not args.json)
     except AffordplanError as exc:  # bad sizes, missing or broken weights, an unreadable frames file, ...
-        print(f"primitives.sensitivity: error: {exc}", file=sys.stderr)
+        print(f"primitives.research.sensitivity: error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     if args.plot:

@@ -1,7 +1,7 @@
 """Scripted pushes read off a policy observation: an exploration prior for training push.
 
 A push-straight succeeds only when the push line passes within millimetres of the centre of mass and the
-contact sits low enough not to tip the object (:mod:`primitives.ceiling`): about one push in three of
+contact sits low enough not to tip the object (:mod:`primitives.research.ceiling`): about one push in three of
 that shape succeeds on the held-out family, while an exploring policy early in training succeeds on
 6-8 % of its pushes, so the critic sees few positives. With probability ``Exploration.p_scripted``
 a training worker replaces its action with :func:`scripted_push`; the transition enters the replay like
@@ -9,7 +9,7 @@ any other. The critic regresses the immediate reward, so off-policy samples need
 actor then climbs towards what the critic learned from them.
 
 The rule uses only what the policy itself sees (the goal-frame observation of
-:func:`primitives.env.observation`): points centred on their horizontal mean, outward normals, and the
+:func:`primitives.training.env.observation`): points centred on their horizontal mean, outward normals, and the
 goal flow. No centre of mass, no dense cloud:
 
 - **direction**: +x of the goal frame when a direction is asked (the flow is non-zero), otherwise a

@@ -1,7 +1,7 @@
 """Kill a training run with SIGKILL at random moments, resume it each time, and measure what was lost.
 
-    python -m primitives.killtest push --kills 5 --out /tmp/killtest
-    python -m primitives.killtest spin --kills 3 --steps 400 --checkpoint-seconds 2 --workers 1 --out /tmp/kt
+    python -m primitives.research.killtest push --kills 5 --out /tmp/killtest
+    python -m primitives.research.killtest spin --kills 3 --steps 400 --checkpoint-seconds 2 --workers 1 --out /tmp/kt
 
 What it does: starts ``python -m primitives.train PRIMITIVE ... --checkpoint-minutes C`` (a small
 config: few points, a small replay) in a process group of its own, waits a random time after the
@@ -204,7 +204,7 @@ def _command(pid: int) -> str:
 
 def _checkpoint_step(path: Path) -> tuple[int, float]:
     """``(global_step, modification time)`` of a checkpoint; ``(0, 0.0)`` when there is none."""
-    from primitives import checkpoint as ckpt
+    from primitives.training import checkpoint as ckpt
 
     if not path.exists():
         return 0, 0.0
@@ -339,12 +339,12 @@ def _check_truncated(primitive, root: Path, run_dir: Path, steps, interval_s, wo
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m primitives.killtest",
+        prog="python -m primitives.research.killtest",
         description="SIGKILL a training run at random moments, resume it with --resume each time, and check that "
                     "it continues from its last checkpoint, loses at most one checkpoint interval, and finishes.",
         epilog="examples:\n"
-               "  python -m primitives.killtest push --kills 5 --out /tmp/killtest\n"
-               "  python -m primitives.killtest spin --kills 3 --workers 1 --out /tmp/kt --overwrite --json",
+               "  python -m primitives.research.killtest push --kills 5 --out /tmp/killtest\n"
+               "  python -m primitives.research.killtest spin --kills 3 --workers 1 --out /tmp/kt --overwrite --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("primitive", choices=["push", "roll", "spin"])

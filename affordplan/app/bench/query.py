@@ -30,8 +30,8 @@ import torch
 
 from affordplan.errors import InputError
 from primitives import params as skill_params
-from primitives.env import PRIMITIVES, skill_observation
-from primitives.success import time_calls
+from primitives.training.env import PRIMITIVES, skill_observation
+from primitives.training.success import time_calls
 
 TARGET_MS = 5.0  # issue target: one query under 5 ms on 2 cores
 WARM_UP = 10  # untimed calls before each timing

@@ -1,7 +1,7 @@
 """Ship a candidate set of one skill's files as the package's weights, keeping the old ones and the provenance.
 
-    python -m primitives.ship push --from primitives/weights/candidates/push_60_bf16 --keep push_0.16 --release 0.18.0
-    python -m primitives.ship push --from DIR --keep NAME --dry-run     # print what would move, change nothing
+    python -m primitives.research.ship push --from candidates/push_60_bf16 --keep push_0.16 --release 0.18.0
+    python -m primitives.research.ship push --from DIR --keep NAME --dry-run     # print what would move, change nothing
 
 A **candidate set** is a folder laid out like ``primitives/weights/`` (what ``--weights-dir`` runs): ``{skill}.pt``
 (the policy) and ``{skill}_success.pt`` (its goal-frame success model), optionally ``{skill}_frames.json`` (the
@@ -15,8 +15,8 @@ Shipping does, in this order, and changes nothing until every check has passed:
    fitted files were fitted with *its* files: each run path their ``info`` names (``policy``, ``model``,
    ``frames``) must, where it exists on this machine, be byte for byte (sha256) the set's file of that role.
    A path that is absent here is reported, not refused; ``"shipped"`` (a set that was shipped before) passes.
-2. **Keep** the skill's shipped files: move them to ``candidates/KEEP/`` beside the weights (refused if that
-   folder exists), so that ``--weights-dir primitives/weights/candidates/KEEP`` still runs them.
+2. **Keep** the skill's shipped files: move them to ``candidates/KEEP/`` in the repository root, outside the packages
+   (refused if that folder exists), so that ``--weights-dir candidates/KEEP`` still runs them.
 3. **Copy** the set's files in. In the fitted files (both success models, the frames file) each of ``policy``,
    ``model`` and ``frames`` that names a path becomes ``"shipped"``; the path moves to ``trained_with``; and a
    ``note`` records the release and the sha256 of the shipped files it was fitted with. The weights themselves
@@ -37,9 +37,9 @@ from pathlib import Path
 
 from affordplan.errors import AffordplanError, InputError, WeightsError
 from primitives import weights_file
-from primitives.env import PRIMITIVES
 from primitives.frames import FrameSearch
-from primitives.success import WEIGHTS_DIR
+from primitives.training.env import PRIMITIVES
+from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
 ROLES = ("policy", "model", "frames")  # the info keys of a fitted file that name the files it was fitted with
 SHIPPED = "shipped"
@@ -104,7 +104,8 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
     """Check a candidate set (module docstring, step 1) and say what shipping it would move; change nothing.
 
     ``base``: the folder that relative run paths in the files' ``info`` are taken from (the repository root,
-    where the training commands ran). Raises :class:`InputError` for a set that cannot ship.
+    where the training commands ran); the files now shipped are kept in ``base/candidates/KEEP``.
+    Raises :class:`InputError` for a set that cannot ship.
     """
     from primitives.skills import load_skill
 
@@ -118,7 +119,7 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
         raise InputError("the candidate set is the weights folder itself")
     if not keep or Path(keep).name != keep or keep in (".", ".."):
         raise InputError(f"--keep must be a plain folder name under candidates/, got {keep!r}")
-    keep_dir = weights_dir / "candidates" / keep
+    keep_dir = Path(base) / "candidates" / keep
     if keep_dir.exists():
         raise InputError(f"{keep_dir} exists already; choose another --keep name")
     names = role_files(skill)
@@ -193,11 +194,12 @@ def ship(plan: ShipPlan, release: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m primitives.ship", description=__doc__,
+    parser = argparse.ArgumentParser(prog="python -m primitives.research.ship", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("skill", choices=PRIMITIVES)
     parser.add_argument("--from", dest="source", required=True, help="the candidate set (a folder like weights/)")
-    parser.add_argument("--keep", required=True, help="folder name under weights/candidates/ for the files now shipped")
+    parser.add_argument("--keep", required=True,
+                        help="folder name under candidates/ (in the repository root) for the files now shipped")
     parser.add_argument("--release", default=None, help="the release the note names (default: the package version)")
     parser.add_argument("--weights-dir", default=None, help="the weights folder to ship into (default: the package's)")
     parser.add_argument("--dry-run", action="store_true", help="check and print what would move; change nothing")

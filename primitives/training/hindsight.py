@@ -37,7 +37,7 @@ from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Outcome
 from primitives import params as skill_params
 from primitives import rewards
-from primitives.env import SkillObservation, observe_cloud
+from primitives.training.env import SkillObservation, observe_cloud
 
 MIN_PUSH_MOVE = 0.01  # metres: shorter moves have no heading worth relabelling to
 MIN_SPIN_TURN = math.radians(5.0)

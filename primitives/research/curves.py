@@ -1,6 +1,6 @@
 """Learning curves (success and reward vs steps) and the memory curve of training runs, as a PNG.
 
-    python -m primitives.curves runs/push runs/roll runs/spin --out curves.png
+    python -m primitives.research.curves runs/push runs/roll runs/spin --out curves.png
 """
 
 from __future__ import annotations
@@ -58,8 +58,9 @@ def plot_curves(runs: list[str | Path], out: str | Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m primitives.curves", description=__doc__.split("\n\n")[0],
-                                epilog="example:\n  python -m primitives.curves runs/push runs/roll --out curves.png",
+    p = argparse.ArgumentParser(prog="python -m primitives.research.curves", description=__doc__.split("\n\n")[0],
+                                epilog="example:\n"
+                                "  python -m primitives.research.curves runs/push runs/roll --out curves.png",
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("runs", nargs="+", help="run folders (each with a log.csv)")
     p.add_argument("--out", default="curves.png")
