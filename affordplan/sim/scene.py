@@ -2,7 +2,7 @@
 
 The scene holds a table plane, the object as one free body whose geoms are its convex parts (mesh
 vertices inlined; the inertia is the true solid's, not the parts' sum), box obstacles, and the
-pusher. Options and contact parameters are the ones DESIGN.md measured to give stable contacts.
+pusher. Options and contact parameters are the ones measured here (docs/guide.md) to give stable contacts.
 
 Collision filtering (contype / conaffinity): the table collides with the object only; the finger
 collides with the object and obstacles but not the table (its targets are clamped above it).

@@ -1,6 +1,6 @@
 """The MuJoCo simulator: reset an object, observe it, execute one primitive.
 
-A primitive follows HACMan's protocol (DESIGN.md): the fingertip is brought 4 cm out along the
+A primitive follows HACMan's protocol (docs/architecture.md): the fingertip is brought 4 cm out along the
 contact's outward normal (the finger teleports there; the arm transits at a safe height above the
 obstacles and the object, then descends), servoes to 2 cm, then to the contact (the tip's surface touching it); the
 motion is 3 control steps that each move the target by ``motion * 3 cm`` over 0.5 s; the finger
