@@ -31,6 +31,7 @@ import numpy as np
 import torch
 
 from affordplan.errors import WeightsError
+from affordplan.log import cli_logging
 
 FORMAT = "affordplan-weights"
 FORMAT_VERSION = 1
@@ -163,6 +164,7 @@ def main(argv: list[str] | None = None) -> int:
     st.add_argument("--sensor", default="surface", choices=("surface", "cameras"),
                     help="the clouds it was trained on (default: %(default)s, what every release before 0.24 used)")
     args = p.parse_args(argv)
+    cli_logging()
     try:
         if args.command == "show":
             content = read(args.path)

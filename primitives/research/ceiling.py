@@ -46,6 +46,7 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
+from affordplan.log import cli_logging
 from affordplan.sim.simulator import Simulator
 from primitives.training.env import PrimitiveEnv
 from primitives.training.evaluate import greedy_action, held_out_config, load_policy
@@ -221,6 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    cli_logging()
     if args.starts < 1:
         parser.error(f"--starts must be a positive integer, got {args.starts}")
     torch.set_num_threads(1)

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import math
 import time
 from dataclasses import dataclass
@@ -32,11 +33,14 @@ import numpy as np
 import torch
 from scipy import stats
 
+from affordplan.log import cli_logging
 from primitives.training import checkpoint as ckpt
 from primitives.training.env import PRIMITIVES
 from primitives.training.evaluate import evaluate, load_policy
 from primitives.training.rollouts import BACKENDS, connect_ray, import_ray
 from primitives.training.train import TrainConfig, train
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -100,10 +104,10 @@ def compare(primitive: str, steps: int, seeds: int, trials: int, out: Path, work
                                  eval_invalid=result.invalid))
                 if progress:
                     r = runs[-1]
-                    print(f"{backend:5s} seed {seed}: {r['steps']} steps, {r['updates']} updates, "
-                          f"{r['train_seconds']:.0f} s; collect success {r['collect_successes']}/"
-                          f"{r['collect_transitions']}, greedy success {r['greedy_successes']}/{r['greedy_trials']}",
-                          flush=True)
+                    logger.info("%-5s seed %s: %s steps, %s updates, %.0f s; collect success %s/%s, greedy success "
+                                "%s/%s", backend, seed, r["steps"], r["updates"], r["train_seconds"],
+                                r["collect_successes"], r["collect_transitions"], r["greedy_successes"],
+                                r["greedy_trials"])
     finally:
         if owns_ray:
             import_ray().shutdown()
@@ -143,6 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    cli_logging()
     torch.set_num_threads(1)
     report = compare(args.primitive, args.steps, args.seeds, args.trials, Path(args.out), workers=args.workers,
                      eval_seed=args.eval_seed, ray_address=args.ray_address, progress=True,

@@ -10,6 +10,7 @@ import csv
 from pathlib import Path
 
 from affordplan.errors import InputError
+from affordplan.log import cli_logging
 
 
 def read_log(run: str | Path) -> dict[str, list[float]]:
@@ -65,6 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("runs", nargs="+", help="run folders (each with a log.csv)")
     p.add_argument("--out", default="curves.png")
     args = p.parse_args(argv)
+    cli_logging()
     try:
         plot_curves(args.runs, args.out)
     except InputError as exc:

@@ -36,6 +36,7 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
+from affordplan.log import cli_logging
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
 from primitives.training.env import PRIMITIVES, PrimitiveEnv
@@ -198,6 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    cli_logging()
     if args.starts < 1:
         parser.error(f"--starts must be a positive integer, got {args.starts}")
     torch.set_num_threads(1)

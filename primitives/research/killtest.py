@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import os
 import re
 import shutil
@@ -35,10 +36,15 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from affordplan.log import cli_logging
+
+logger = logging.getLogger(__name__)
 
 SLACK_S = 2.0  # one learner loop iteration and the checkpoint write, on a loaded 2-core machine
 _PROGRESS = re.compile(r"(\d+)/(\d+) \[")
@@ -224,15 +230,17 @@ def train_command(primitive: str, out: Path, steps: int, interval_s: float, work
 def killtest(primitive: str = "push", kills: int = 5, out: str | os.PathLike = "killtest", steps: int = 4000,
              interval_s: float = 3.0, workers: int = 0, seed: int = 0, timeout: float = 600.0,
              overwrite: bool = False, window: tuple[float, float] | None = None, check_truncated: bool = True,
-             log=print, signals: tuple[str, ...] = ("KILL",)) -> KillTestResult:
+             log: Callable[[str], None] | None = None, signals: tuple[str, ...] = ("KILL",)) -> KillTestResult:
     """Run the kill-and-resume test (see the module docstring); ``out`` is created and must not exist
     unless ``overwrite``.
 
     ``window``: seconds after a run begins stepping within which its kill falls (uniformly; default
     ``(0.5, 3 * interval_s)``). ``check_truncated``: also check ``--resume`` from a truncated checkpoint.
     ``signals``: what stops each run, in turn (``KILL``, ``INT``: Ctrl-C, ``TERM``); a run stopped by INT or TERM
-    must save a checkpoint and exit by itself (status 130).
+    must save a checkpoint and exit by itself (status 130). ``log``: where each stop's and the final run's line goes
+    (default: this module's logger, at INFO).
     """
+    log = log or logger.info
     low, high = window or (0.5, 3.0 * interval_s)
     root = Path(out)
     if root.exists():
@@ -365,7 +373,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    quiet = (lambda *a, **k: None) if args.json else (lambda *a, **k: print(*a, **k, flush=True))
+    cli_logging()
+    quiet = (lambda message: None) if args.json else logger.info
     result = killtest(args.primitive, args.kills, args.out, args.steps, args.checkpoint_seconds, args.workers,
                       args.seed, args.timeout, args.overwrite, log=quiet, signals=tuple(args.signals))
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())

@@ -41,6 +41,7 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
+from affordplan.log import cli_logging
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
 from primitives.research.frame_ceiling import add_held_out_arguments
@@ -220,6 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    cli_logging()
     torch.set_num_threads(1)
     try:
         result = sensitivity(args.skill, args.starts, args.params, args.options, args.seed,

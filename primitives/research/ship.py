@@ -36,6 +36,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from affordplan.errors import AffordplanError, InputError, WeightsError
+from affordplan.log import cli_logging
 from primitives import weights_file
 from primitives.frames import FrameSearch
 from primitives.training.env import PRIMITIVES
@@ -204,6 +205,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--weights-dir", default=None, help="the weights folder to ship into (default: the package's)")
     parser.add_argument("--dry-run", action="store_true", help="check and print what would move; change nothing")
     args = parser.parse_args(argv)
+    cli_logging()
     try:
         plan = plan_ship(args.skill, args.source, args.keep, args.weights_dir)
     except InputError as exc:

@@ -24,6 +24,7 @@ import torch
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
+from affordplan.log import cli_logging
 from affordplan.objects import housekeep
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
@@ -288,6 +289,7 @@ def _frame_search(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    cli_logging()
     if args.trials < 1:
         parser.error(f"--trials must be a positive integer, got {args.trials}")
     torch.set_num_threads(1)

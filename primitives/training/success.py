@@ -55,6 +55,7 @@ import torch.nn.functional as F
 from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
+from affordplan.log import cli_logging
 from primitives import weights_file
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
 from primitives.networks import HybridActorCritic
@@ -665,6 +666,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    cli_logging()
     if args.rollouts < 1:
         parser.error(f"--rollouts must be a positive integer, got {args.rollouts}")
     if getattr(args, "views", False) and args.frames is None:

@@ -50,6 +50,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import logging
 import os
 import resource
 import signal
@@ -66,6 +67,7 @@ from tqdm import tqdm
 
 from affordplan.checks import is_finite, require_probability, require_whole
 from affordplan.errors import InputError
+from affordplan.log import cli_logging
 from primitives import weights_file
 from primitives.networks import HybridActorCritic
 from primitives.training import checkpoint as ckpt
@@ -73,6 +75,8 @@ from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv
 from primitives.training.hindsight import relabel
 from primitives.training.replay import ReplayBuffer
 from primitives.training.rollouts import BACKENDS, Exploration, act, import_ray, make_source, rss_mb
+
+logger = logging.getLogger(__name__)
 
 PRECISIONS = ("fp32", "bf16")
 
@@ -287,8 +291,8 @@ def _train_locked(cfg: TrainConfig, out: Path, resume: bool, progress: bool) -> 
     torch.set_num_threads(cfg.torch_threads)
     torch.manual_seed(cfg.seed)
     if cfg.precision == "bf16" and not bf16_is_fast():
-        print("--precision bf16: this CPU has no native bfloat16 (AMX / AVX512-BF16); the learner will be "
-              "slower than with fp32", file=sys.stderr)
+        logger.warning("--precision bf16: this CPU has no native bfloat16 (AMX / AVX512-BF16); the learner will be "
+                       "slower than with fp32")
     model = HybridActorCritic()
     if cfg.init and not (resume and (out / "checkpoint.pt").exists()):
         from primitives.policy import load_policy
@@ -303,8 +307,8 @@ def _train_locked(cfg: TrainConfig, out: Path, resume: bool, progress: bool) -> 
     state = dict(global_step=0, n_updates=0, invalid=0, elapsed=0.0, rss_samples=[])
     ckpt_path = out / "checkpoint.pt"
     if resume and not ckpt_path.exists():
-        print(f"no checkpoint in {out} yet (the run stopped before its first): starting it again from step 0",
-              file=sys.stderr)
+        logger.warning("no checkpoint in %s yet (the run stopped before its first): starting it again from step 0",
+                       out)
         resume = False
     elif resume:
         saved = ckpt.load(ckpt_path)  # any skill: check_resume names what differs
@@ -444,9 +448,9 @@ def _train_locked(cfg: TrainConfig, out: Path, resume: bool, progress: bool) -> 
                                                  steps=state["global_step"], updates=state["n_updates"]))
     else:
         policy_path.unlink(missing_ok=True)
-        print(f"warning: no updates were made ({state['global_step']} steps, learning starts at "
-              f"{cfg.learning_starts} transitions): no policy.pt written; run longer (--steps) or lower "
-              "--learning-starts", file=sys.stderr)
+        logger.warning("warning: no updates were made (%s steps, learning starts at %s transitions): no policy.pt "
+                       "written; run longer (--steps) or lower --learning-starts",
+                       state["global_step"], cfg.learning_starts)
     summary = dict(primitive=cfg.primitive, steps=state["global_step"], updates=state["n_updates"],
                    minutes=state["elapsed"] / 60, invalid=state["invalid"], trained=trained, interrupted=interrupted,
                    peak_rss_mb_learner=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
@@ -552,6 +556,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    cli_logging()
     cfg = TrainConfig(
         primitive=args.primitive, objects=args.objects, sensor=args.sensor,
         steps=args.steps, workers=args.workers, backend=args.backend,
@@ -578,8 +583,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     print(json.dumps({k: v for k, v in summary.items() if k != "rss_samples"}, indent=2))
     if summary["interrupted"]:
-        print(f"interrupted at step {summary['steps']}: checkpoint saved; continue with --resume --out {cfg.out}",
-              file=sys.stderr)
+        logger.warning("interrupted at step %s: checkpoint saved; continue with --resume --out %s",
+                       summary["steps"], cfg.out)
         return 130
     return 0
 

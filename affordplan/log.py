@@ -1,0 +1,38 @@
+"""Logging for the command lines: the one place that decides how library messages reach a terminal.
+
+Library code never prints a diagnostic, progress or status message: each module logs through
+``logger = logging.getLogger(__name__)`` and leaves the output to whoever runs it. A program that embeds the library
+configures :mod:`logging` as it likes; a command line (a ``main()``) calls :func:`cli_logging` once, so that those
+messages reach the user as plain lines on stderr, while the program's results (tables, JSON) stay on stdout.
+"""
+
+from __future__ import annotations
+
+import logging
+
+# The loggers a command line turns up: the three packages, and ``__main__``, the name a module run with
+# ``python -m package.module`` logs under.
+CLI_LOGGERS = ("affordplan", "primitives", "planner", "__main__")
+
+
+def cli_logging(verbose: bool = False) -> None:
+    """Show the library's log messages on stderr as plain lines (``%(message)s``), for a command line's ``main()``.
+
+    Does nothing when the root logger already has a handler: logging configured by the program that called
+    ``main()`` (or by pytest, whose capture handlers are installed during a test) is left as it is, so calling this
+    twice, or from an embedding program, changes nothing.
+
+    Otherwise installs one stderr handler on the root logger and lets the loggers of ``affordplan``, ``primitives``,
+    ``planner`` and ``__main__`` through from INFO (from DEBUG if ``verbose``); other libraries' loggers keep the
+    root's WARNING, so their chatter stays out of the output while their warnings still show.
+
+    Args:
+        verbose: also show DEBUG messages of the three packages.
+    """
+    root = logging.getLogger()
+    if root.handlers:
+        return
+    logging.basicConfig(level=logging.WARNING, format="%(message)s")
+    level = logging.DEBUG if verbose else logging.INFO
+    for name in CLI_LOGGERS:
+        logging.getLogger(name).setLevel(level)
