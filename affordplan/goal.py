@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, TypeAlias, TypedDict
 
 import numpy as np
 
@@ -11,6 +12,24 @@ from affordplan.checks import as_finite, as_vector, describe, is_whole
 from affordplan.errors import GoalError, InputError
 from affordplan.geometry import wrap_period
 from affordplan.objects.model import ObjectModel
+
+
+class Start(TypedDict, total=False):
+    """Where :func:`affordplan.plan` starts the object (every key optional).
+
+    Keys:
+        resting_state: index into ``obj.resting_states`` (default 0).
+        xy: centre of mass on the table, metres, world frame (default: the workspace's centre).
+        yaw: heading in that resting state, radians (default 0).
+    """
+
+    resting_state: int
+    xy: tuple[float, float]
+    yaw: float
+
+
+# What affordplan.plan's ``start`` takes: a Start dict, or a 4x4 world pose resting on the table; None: the defaults.
+StartLike: TypeAlias = Start | dict[str, Any] | np.ndarray | None
 
 
 @dataclass(frozen=True)
@@ -59,6 +78,19 @@ class Goal:
         object.__setattr__(self, "yaw_symmetric", bool(self.yaw_symmetric))
         object.__setattr__(self, "xy_tol", tolerances[0])
         object.__setattr__(self, "yaw_tol", tolerances[1])
+
+    @classmethod
+    def from_degrees(cls, xy: tuple[float, float], yaw_deg: float | None = None, resting_state: int | None = None,
+                     xy_tol: float = 0.03, yaw_tol_deg: float = 15.0, yaw_symmetric: bool = True) -> Goal:
+        """The goal with its yaw and yaw tolerance in degrees (as scene files may give them); the constructor's
+        unit stays radians. ``Goal.from_degrees((0.6, 0.0), 90)`` is ``Goal((0.6, 0.0), math.radians(90))``."""
+        try:
+            yaw = None if yaw_deg is None else math.radians(as_finite("goal yaw_deg (degrees)", yaw_deg))
+            yaw_tol = math.radians(as_finite("goal yaw_tol_deg (degrees)", yaw_tol_deg))
+        except InputError as exc:
+            raise GoalError(str(exc)) from None
+        return cls(xy=xy, yaw=yaw, resting_state=resting_state, xy_tol=xy_tol, yaw_tol=yaw_tol,
+                   yaw_symmetric=yaw_symmetric)
 
     def check_object(self, obj: ObjectModel) -> None:
         """Raise :class:`GoalError` when the resting state does not exist for ``obj``."""

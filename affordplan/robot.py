@@ -6,6 +6,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
+
+SkillName = Literal["push", "roll", "spin"]
+SKILLS: tuple[SkillName, ...] = ("push", "roll", "spin")  # the robot's skills, in the one order every listing uses
 
 TIP_RADIUS = 0.008  # metres: the fingertip sphere
 # Metres from the base (the world origin) within which the arm's IK accepts a fingertip target pointing down:

@@ -3,28 +3,30 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any, Literal, get_args
 
 import numpy as np
 
 from affordplan.checks import as_finite, as_seed, as_vector, as_whole, describe
 from affordplan.errors import GoalError, InputError
-from affordplan.goal import Goal
+from affordplan.goal import Goal, StartLike
 from affordplan.objects.model import ObjectModel
-from affordplan.world import Box, Workspace
+from affordplan.world import Box, Workspace, as_box
 from planner.footprint import footprint
 from planner.motion import FootprintChecker
 from planner.plan import WORKSPACE_OVERHANG, Plan, Planner
 from planner.predict import Predictor
 
-PLANNERS = ("affordplan", "greedy")
+PlannerName = Literal["affordplan", "greedy"]
+PLANNERS: tuple[PlannerName, ...] = get_args(PlannerName)
 
 
 START_TILT_MAX = math.radians(10.0)  # a start pose is this close to one of its resting states, or refused
 START_HEIGHT_MAX = 0.01  # metres off the state's resting height (a pose floating above the table is refused)
 
 
-def start_pose(obj: ObjectModel, start) -> np.ndarray:
+def start_pose(obj: ObjectModel, start: StartLike) -> np.ndarray:
     """The 4x4 world pose of ``start``: a dict ``{"resting_state", "xy", "yaw"}`` or a 4x4 pose."""
     if start is None:
         start = {}
@@ -77,10 +79,15 @@ def check_start(obj: ObjectModel, T_start: np.ndarray, obstacles: Sequence[Box],
         raise GoalError(f"the start pose is in collision: {why}")
 
 
-def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] = (), time_limit: float = 5.0,
-         planner: str = "affordplan", seed: int = 0, predictor: Predictor | None = None,
+def plan(obj: ObjectModel, goal: Goal, *, start: StartLike = None,
+         obstacles: Iterable[Box | Mapping[str, Any]] = (), time_limit: float = 5.0,
+         planner: PlannerName = "affordplan", seed: int = 0, predictor: Predictor | None = None,
          workspace: Workspace = Workspace()) -> Plan:
     """Plan to bring ``obj`` from ``start`` to ``goal`` among ``obstacles`` (see :class:`planner.plan.Planner`).
+
+    ``start``: a :class:`affordplan.goal.Start` dict ``{"resting_state": i, "xy": (x, y), "yaw": rad}`` (each key
+    optional) or a 4x4 world pose. ``obstacles``: :class:`affordplan.Box` objects, or dicts in the scene-file form
+    ``{"center": [x, y], "size": [sx, sy, sz], "yaw": rad}`` (or ``"yaw_deg"``; :meth:`affordplan.Box.from_dict`).
 
     ``planner="greedy"`` returns the reactive baseline: a plan without steps whose ``execute`` picks
     every call on the spot (:func:`planner.execute.execute_greedy`).
@@ -89,7 +96,7 @@ def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] =
         GoalError: the goal is malformed, in an obstacle, off the workspace or in a resting state the
             object does not have; or the start is in collision, off the workspace or in a resting
             state the object does not have.
-        InputError: a malformed start (NaN, wrong shape, unknown keys), planner or time limit.
+        InputError: a malformed start (NaN, wrong shape, unknown keys), obstacle, planner or time limit.
         PlanningError: no plan within ``time_limit``; the message names why (no collision-free path,
             no room to roll, no chain of rolls, out of time).
     """
@@ -103,12 +110,13 @@ def plan(obj: ObjectModel, goal: Goal, *, start=None, obstacles: Sequence[Box] =
     if time_limit == 0.0:
         raise InputError("time_limit must be a positive number of seconds, got 0")
     seed = as_seed("seed", seed)
-    if isinstance(obstacles, (str, bytes)) or not hasattr(obstacles, "__iter__"):
-        raise InputError(f"obstacles must be a sequence of affordplan.Box, got {describe(obstacles)}")
+    if isinstance(obstacles, (str, bytes, Mapping)) or not hasattr(obstacles, "__iter__"):
+        raise InputError(f"obstacles must be a sequence of affordplan.Box (or of box dicts), got "
+                         f"{describe(obstacles)}")
     T0 = start_pose(obj, start)
-    obstacles = tuple(obstacles)
-    p = Planner(obj, obstacles, workspace, predictor=predictor, time_limit=time_limit, seed=seed)
-    check_start(obj, T0, obstacles, workspace)
+    boxes = tuple(as_box(b, f"obstacles[{i}]") for i, b in enumerate(obstacles))
+    p = Planner(obj, boxes, workspace, predictor=predictor, time_limit=time_limit, seed=seed)
+    check_start(obj, T0, boxes, workspace)
     if planner == "greedy":
         p.check_goal(goal, obj.classify(T0))
         return Plan(steps=[], p_success=float("nan"), planning_time=0.0, route=[], goal=goal, start_pose=T0,

@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -29,7 +31,10 @@ from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
 from planner.predict import expected_pose
 from primitives import params as skill_params
-from primitives.skills import skills_sensor
+from primitives.skills import Skill, skills_sensor
+
+if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its plans
+    from planner.plan import Planner
 
 XY_TOL = 0.025  # metres off the plan before replanning
 YAW_TOL = math.radians(12.0)
@@ -89,6 +94,7 @@ class Execution:
     planning_time: float = 0.0
     frames: list[np.ndarray] = field(default_factory=list, repr=False)
     errors: tuple[float, float, bool] | None = None
+    plan_times: list[float] = field(default_factory=list)  # seconds of the first plan and of each replan
 
     def __str__(self) -> str:
         head = (f"execution: {'SUCCESS' if self.success else 'FAILED'} after {self.n_primitives} primitives, "
@@ -198,16 +204,24 @@ def made_progress(obj: ObjectModel, skill: str, params: dict, T_before: np.ndarr
     return turn * math.copysign(1.0, asked) >= MIN_SPIN_SHARE * abs(asked)
 
 
-def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
-    """Run ``plan`` closed-loop (see the module docstring)."""
-    planner, goal = plan.planner, plan.goal
+def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0,
+                 skills: Mapping[str, Skill] | None = None, memory: Planner | None = None) -> Execution:
+    """Run ``plan`` closed-loop (see the module docstring).
+
+    ``skills``: the skills that act (default: the ones the plan was rated with). ``memory``: the planner that replans
+    and remembers failures (default: a fork of the plan's planner, :meth:`planner.plan.Planner.fork`), so the plan
+    and its planner are left as they were; pass one planner to several executions to let them share what failed.
+    """
+    planner, goal = memory if memory is not None else plan.planner.fork(), plan.goal
+    skills = skills if skills is not None else planner.predictor.skills
     obj = planner.obj
-    sim = _simulator(sim, obj, planner.obstacles, plan.start_pose, seed, skills_sensor(planner.predictor.skills))
+    sim = _simulator(sim, obj, planner.obstacles, plan.start_pose, seed, skills_sensor(skills))
     steps, k = list(plan.steps), 0
     log: list[LogEntry] = []
     frames: list[np.ndarray] = []
     _record_frame(sim, render, frames)
     replans, planning_time, reason = 0, plan.planning_time, "max_primitives reached"
+    plan_times = [plan.planning_time]
     for n in range(max_primitives + 1):
         T = sim.object_pose()
         if goal.reached(obj, T):
@@ -225,11 +239,12 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
             steps, k, replanned = list(new.steps), 0, True
             replans += 1
             planning_time += new.planning_time
+            plan_times.append(new.planning_time)
             if not steps:
                 reason = "planner has nothing left to do but the goal is not reached"
                 break
         step = steps[k]
-        skill = planner.predictor.skills[step.skill]
+        skill = skills[step.skill]
         try:
             out = skill.execute(sim, step.params)
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
@@ -250,7 +265,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         k += 1
     T = sim.object_pose()
     return Execution(goal.reached(obj, T), T, len(log), replans, log, reason, planning_time, frames,
-                     goal.errors(obj, T))
+                     goal.errors(obj, T), plan_times)
 
 
 # ------------------------------------------------------------------------------- greedy

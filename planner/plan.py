@@ -28,11 +28,13 @@ path's own is not).
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -46,7 +48,13 @@ from planner import chain
 from planner.footprint import footprint, inflate, place
 from planner.graph import RestingStateGraph
 from planner.motion import FootprintChecker, plan_path
+from planner.odds import DEFAULT_BUDGET, Odds, plan_odds
 from planner.predict import Predictor, expected_pose, state_pose
+from primitives.params import PARAMS_TYPES, SkillName, SkillParams, as_params
+
+if TYPE_CHECKING:  # planner.execute imports this module's Planner; Plan.execute imports it when called
+    from affordplan.sim.simulator import Simulator
+    from planner.execute import Execution
 
 FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is avoided
 SPLIT_ANGLE = math.radians(35.0)
@@ -83,6 +91,11 @@ ARM_REACH = FINGERTIP_REACH - 0.025  # 0.79 m
 # on seeds 0 and 1 (0.92, 0.84), and half still keeps the die's turns off its goal 0.68 m out.
 SPIN_DRIFT = 0.5
 FREE_YAW_STEPS = np.radians([0.0] + [sign * a for a in range(5, 180, 5) for sign in (1, -1)] + [180.0])
+# A goal is a region: where its exact point is not free, the plan aims at the nearest free placement (rings of
+# GOAL_AIM_RING metres, turns of GOAL_AIM_YAW_STEP radians) within GOAL_AIM_SHARE of its tolerances.
+GOAL_AIM_SHARE = 0.6
+GOAL_AIM_RING = 0.002
+GOAL_AIM_YAW_STEP = math.radians(2.5)
 FREE_SEARCH_SLACK = 0.02  # metres past the nearest free position that _nearest_free looks for a better one
 TURN_SPOT_MOVE_COST = 0.05  # metres of path a turn spot other than the object's own place must save (_turn_spot)
 # Radius (metres) of the disc kept clear of obstacles where the fingertip comes down behind an object to push
@@ -95,17 +108,31 @@ class Step:
     """One skill call of a plan.
 
     Attributes:
-        skill: ``"push"``, ``"spin"`` or ``"roll"``.
-        params: its parameter (see :mod:`primitives.params`).
+        skill: ``"push"``, ``"roll"`` or ``"spin"``.
+        params: its parameter as a dict, ``{"direction": rad}`` ... (see :mod:`primitives.params`); given as a typed
+            value (:class:`~primitives.params.PushParams` ...), its dict is kept; :attr:`typed_params` reads it typed.
         start_pose, expected_pose: 4x4 world poses before and (ideally) after.
         p_success: the skill's predicted success at ``start_pose``.
     """
 
-    skill: str
-    params: dict
+    skill: SkillName
+    params: dict[str, float]
     start_pose: np.ndarray = field(repr=False)
     expected_pose: np.ndarray = field(repr=False)
     p_success: float = float("nan")
+
+    def __init__(self, skill: SkillName, params: SkillParams | Mapping[str, float], start_pose: np.ndarray,
+                 expected_pose: np.ndarray, p_success: float = float("nan")) -> None:
+        self.skill = skill
+        self.params = as_params(skill, params)
+        self.start_pose = start_pose
+        self.expected_pose = expected_pose
+        self.p_success = p_success
+
+    @property
+    def typed_params(self) -> SkillParams:
+        """:attr:`params` as the skill's typed value (:class:`~primitives.params.PushParams` ...)."""
+        return PARAMS_TYPES[self.skill].from_dict(self.params)
 
     def __str__(self) -> str:
         (k, v), = self.params.items()
@@ -198,7 +225,19 @@ class Planner:
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace, reach)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
         self.graph = RestingStateGraph(obj, self._roll_probability)
+        self.budget = DEFAULT_BUDGET  # primitives a plan's odds are rated within (planner.odds)
         self._calls = 0
+
+    def fork(self) -> Planner:
+        """A planner with this one's geometry, success queries and caches and a copy of its failure memory (the
+        failures, the failed roll spots, the roll graph's penalties): what an execution learns from its failures
+        stays in the fork, so running a plan never changes the plan's own planner."""
+        other = copy.copy(self)
+        other.failures = Counter(self.failures)
+        other.failed_roll_spots = list(self.failed_roll_spots)
+        other.graph = copy.copy(self.graph)
+        other.graph.graph = self.graph.graph.copy()
+        return other
 
     # ------------------------------------------------------------------ queries
     def _roll_probability(self, i: int, j: int) -> float:
@@ -247,21 +286,56 @@ class Planner:
         return False
 
     def check_goal(self, goal: Goal, start_state: int) -> int:
-        """The goal's resting state; raises :class:`GoalError` for goals that cannot be met."""
+        """The goal's resting state; raises :class:`GoalError` for goals that cannot be met: no free placement
+        of the object anywhere in the goal's region (:meth:`aim`)."""
         goal.check_object(self.obj)
         state = start_state if goal.resting_state is None else goal.resting_state
         if not self.workspace.contains(goal.xy):
             raise GoalError(f"goal xy={goal.xy} is outside the workspace {self.workspace}")
-        checker = self.checkers[state]
-        if goal.yaw_free(self.obj, state):  # the yaws _free_yaw will try to place the object at the goal
-            yaws = list(FREE_YAW_STEPS)
-        else:  # the goal's yaw and the yaws its state's symmetry makes equal to it
-            period = goal.period(self.obj, state)
-            yaws = [goal.yaw + k * period for k in range(int(round(2.0 * math.pi / period)))]
-        if not any(checker.is_free(*goal.xy, a) for a in yaws):
-            why = checker.why_not_free(*goal.xy, yaws[0])
-            raise GoalError(f"goal xy={goal.xy} is not reachable by the object in resting state {state}: {why}")
+        self.aim(goal, state)
         return state
+
+    def aim(self, goal: Goal, state: int) -> Goal:
+        """The point of the goal's region the plan aims at: the goal itself where the object fits there, else the
+        free placement nearest it within the region (a goal is its tolerance disc and yaw interval, not a point).
+
+        Aims stay inside ``GOAL_AIM_SHARE`` of the tolerances, so the drift of the last primitive still leaves the
+        object in the region. Raises :class:`GoalError` when no part of the region is free.
+        """
+        checker = self.checkers[state]
+        free_yaw = goal.yaw_free(self.obj, state)
+        if free_yaw:  # the yaws _free_yaw will try to place the object at the goal
+            yaws = [(0.0, float(a)) for a in FREE_YAW_STEPS]
+        else:  # the goal's yaw, the yaws its state's symmetry makes equal to it, then turns within the interval
+            period = goal.period(self.obj, state)
+            turns = [0.0] + [s * a for a in np.arange(GOAL_AIM_YAW_STEP, GOAL_AIM_SHARE * goal.yaw_tol + 1e-9,
+                                                        GOAL_AIM_YAW_STEP) for s in (1.0, -1.0)]
+            yaws = [(abs(d), goal.yaw + d + k * period) for d in turns
+                    for k in range(int(round(2.0 * math.pi / period)))]
+        reach = GOAL_AIM_SHARE * goal.xy_tol
+        spots = [(0.0, *goal.xy)]
+        for r in np.arange(GOAL_AIM_RING, reach + 1e-9, GOAL_AIM_RING):
+            n = max(8, int(2 * math.pi * r / GOAL_AIM_RING))
+            spots += [(float(r), goal.xy[0] + r * math.cos(a), goal.xy[1] + r * math.sin(a))
+                      for a in np.linspace(-math.pi, math.pi, n, endpoint=False)]
+        best = None
+        for r, x, y in spots:
+            if best is not None and r > best[0]:
+                break
+            for turn, a in sorted(yaws):
+                if self.workspace.contains((x, y)) and checker.is_free(x, y, a):
+                    if best is None or (r, turn) < best[:2]:
+                        best = (r, turn, x, y, a)
+                    break
+        if best is None:
+            why = checker.why_not_free(*goal.xy, yaws[0][1])
+            raise GoalError(f"goal xy={goal.xy} is not reachable by the object in resting state {state}: no free "
+                            f"placement within {100 * reach:.1f} cm of it ({why})")
+        r, turn, x, y, a = best
+        if r == 0.0 and turn == 0.0:
+            return goal
+        return replace(goal, xy=(float(x), float(y)), yaw=None if free_yaw else float(wrap_angle(a)),
+                       xy_tol=goal.xy_tol - r, yaw_tol=goal.yaw_tol - turn)
 
     # --------------------------------------------------------------------- plan
     def plan(self, T_start: np.ndarray, goal: Goal) -> Plan:
@@ -274,8 +348,10 @@ class Planner:
         """
         t0 = time.perf_counter()
         deadline = t0 + self.time_limit
+        asked = goal
         state, x, y, yaw = self.obj.planar_pose(T_start)
         goal_state = self.check_goal(goal, state)
+        goal = self.aim(goal, goal_state)  # the free part of the goal's region
         turn = not goal.yaw_free(self.obj, goal_state)  # whether the goal's yaw asks for anything
         route = self.graph.route(state, goal_state)
         if turn:
@@ -297,8 +373,10 @@ class Planner:
             raise error
         _, steps, p, paths = best
         self._calls += 1
-        return Plan(steps=steps, p_success=p, planning_time=time.perf_counter() - t0, route=route, paths=paths,
-                    goal=goal, start_pose=np.array(T_start), planner=self)
+        odds = plan_odds([s.p_success for s in steps], self.budget)
+        return Plan(steps=steps, p_success=odds.p_success, planning_time=time.perf_counter() - t0, route=route,
+                    paths=paths, expected_primitives=odds.expected_primitives, p_steps=p,
+                    goal=asked, start_pose=np.array(T_start), planner=self, aim=goal)
 
     def _route_calls(self, route: list[int], start: tuple[float, float, float], goal: Goal, goal_state: int,
                      turn: bool, deadline: float, late_from: int) -> tuple[list, list[tuple[int, np.ndarray]]]:
@@ -641,7 +719,8 @@ class Plan:
 
     Attributes:
         steps: the calls, in order.
-        p_success: product of the steps' predicted success.
+        p_success: predicted probability that closed-loop execution reaches the goal within the planner's
+            primitive budget (``Planner.budget``, 60): each step retried until it succeeds (:mod:`planner.odds`).
         planning_time: seconds.
         route: resting states visited.
         paths: ``(resting state, (m, 3) SE(2) path)`` per segment.
@@ -655,17 +734,37 @@ class Plan:
     goal: Goal | None = None
     start_pose: np.ndarray | None = field(default=None, repr=False)
     planner: Planner | None = field(default=None, repr=False)
-    kind: str = "affordplan"  # or "greedy": no steps, every call chosen on the spot
+    kind: Literal["affordplan", "greedy"] = "affordplan"  # "greedy": no steps, every call chosen on the spot
+    # the primitives closed-loop execution is expected to spend (planner.odds); and the product of the steps'
+    # own predicted success, each on its first try (the chain's odds without replanning; what p_success was
+    # until 0.24)
+    expected_primitives: float = float("nan")
+    p_steps: float = float("nan")
+    aim: Goal | None = None  # the free part of the goal's region the steps lead to (Planner.aim); None: the goal
 
     def __str__(self) -> str:
         if self.kind == "greedy":
             return "plan: greedy (each call chosen on the spot when executed)"
-        head = (f"plan: {len(self.steps)} steps, route {self.route}, P(success) {self.p_success:.3f}, "
-                f"planned in {1e3 * self.planning_time:.0f} ms")
+        head = (f"plan: {len(self.steps)} steps, route {self.route}, p_success {self.p_success:.2f} "
+                f"(closed loop), expected {self.expected_primitives:.1f} primitives; every step first time "
+                f"{self.p_steps:.3f}; planned in {1e3 * self.planning_time:.0f} ms")
         return "\n".join([head] + [f"  {i:2d}. {s}" for i, s in enumerate(self.steps)])
 
-    def execute(self, sim="arm", max_primitives: int = 60, render=None, seed: int = 0):
-        """Run the plan closed-loop (see :mod:`planner.execute`); returns an ``Execution``."""
+    def odds(self, budget: int) -> Odds:
+        """The plan's odds within ``budget`` primitives (:func:`planner.odds.plan_odds`; ``p_success`` is them
+        within the planner's budget)."""
+        if self.kind == "greedy":
+            return Odds(float("nan"), float("nan"), int(budget))
+        return plan_odds([s.p_success for s in self.steps], budget)
+
+    def execute(self, sim: Literal["arm", "finger"] | Simulator = "arm", max_primitives: int = 60,
+                render: bool | str | None = None, seed: int = 0) -> Execution:
+        """Run the plan closed-loop (see :mod:`planner.execute`); returns an ``Execution``.
+
+        ``sim``: a new simulator with the ``"arm"`` or the bare ``"finger"`` pusher, or a :class:`Simulator` holding
+        the plan's object and obstacles; ``render``: a truthy value records a frame per primitive in
+        ``Execution.frames``, a string names the camera (default ``"overview"``); ``seed`` seeds a new simulator.
+        """
         from affordplan.checks import as_whole
         from planner.execute import execute_greedy, execute_plan
 

@@ -24,10 +24,10 @@ from affordplan.sim.sensor import CameraSensor, surface_cloud
 from affordplan.world import Box
 from primitives import params as skill_params
 from primitives.observation import observe_cloud
+from primitives.params import SKILLS
 from primitives.skills import Skill, load_skills, skills_sensor
 
 N_POINTS = 256
-SKILLS = ("push", "spin", "roll")
 
 
 def settle_to_state(obj: ObjectModel, T_world_object: np.ndarray, state: int) -> np.ndarray:

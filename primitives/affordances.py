@@ -23,6 +23,7 @@ from affordplan.geometry import wrap_angle
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
 from primitives import params as skill_params
+from primitives.params import SKILLS
 from primitives.skills import Skill, load_skill
 
 SPIN_ANGLE = math.radians(30.0)
@@ -60,7 +61,7 @@ def _params(skill: str, value, yaw: float) -> dict:
 def affordance_table(obj: ObjectModel, trials: int = 10, sectors: int = 8, seed: int = 0,
                      skills: dict[str, Skill] | None = None, progress: bool = True) -> list[Affordance]:
     """Predicted and measured success of every (state, skill, parameter) on ``obj``."""
-    skills = skills or {name: load_skill(name) for name in ("push", "spin", "roll")}
+    skills = skills or {name: load_skill(name) for name in SKILLS}
     rng = np.random.default_rng(seed)
     sim = Simulator(obj, seed=seed)
     rows: list[Affordance] = []

@@ -18,8 +18,9 @@ import numpy as np
 from affordplan.objects.model import ObjectModel
 from affordplan.sim.simulator import Simulator
 from primitives import params as skill_params
+from primitives.params import SKILLS
 
-PRIMITIVES = ("push", "roll", "spin")
+PRIMITIVES = SKILLS  # the skills, in the one order primitives.params gives them
 OBS_DIM = 9
 
 

@@ -5,7 +5,10 @@
   (bigger turns are chained by the planner);
 - roll: ``{"target": j}``, the index of a resting state one roll away from the current one.
 
-``None`` is the seed's unparameterised objective.
+``None`` is the seed's unparameterised objective. The same requests as typed values: :class:`PushParams`,
+:class:`SpinParams`, :class:`RollParams` (each with ``as_dict()`` and ``from_dict()``); every function that
+takes parameters takes either form, and :func:`as_params` turns either into the dict :func:`check` checks.
+The skills' names, in their one order: :data:`SKILLS`.
 
 **Goal flow** (how a parameter reaches the policy, as HACMan conditions on a goal): for each cloud
 point ``p`` the displacement ``T_param p - p`` (metres, world frame) that the parameter asks for,
@@ -32,14 +35,18 @@ afford. The policy's motion comes back through ``A_frame_world.T``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar, TypeAlias, overload
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from affordplan.checks import as_finite, is_whole
+from affordplan.checks import as_finite, as_whole, describe, is_whole
 from affordplan.errors import InputError
 from affordplan.geometry import rot_z, wrap_angle
 from affordplan.objects.model import ObjectModel
+from affordplan.robot import SKILLS, SkillName  # noqa: F401 (re-exported: the one order of the skills)
 
 PUSH_STEP = 0.05  # metres: what one push is asked to move the object
 SPIN_MIN = math.radians(15.0)
@@ -48,6 +55,135 @@ SPIN_MAX = math.radians(45.0)
 # neighbouring faces are 90 deg apart, its opposite face 180 deg: two rolls).
 ROLL_MAX_TIP = math.radians(135.0)
 WORLD_Z = np.array([0.0, 0.0, 1.0])
+
+
+PARAM_KEYS: dict[str, str] = {"push": "direction", "roll": "target", "spin": "angle"}
+
+
+def _spin_angle(value: object) -> float:
+    """A spin angle in radians, checked: finite, ``SPIN_MIN <= |angle| <= SPIN_MAX``."""
+    angle = as_finite("spin angle (radians)", value)
+    if not SPIN_MIN - 1e-9 <= abs(angle) <= SPIN_MAX + 1e-9:
+        raise InputError(f"spin angle must be between {math.degrees(SPIN_MIN):.0f} and {math.degrees(SPIN_MAX):.0f} "
+                         f"degrees either way, got {math.degrees(angle):.1f} deg (chain spins for more)")
+    return angle
+
+
+def _only_value(skill: str, d: object) -> Any:
+    """The value of a one-key parameter dict for ``skill``; :class:`InputError` for any other shape."""
+    key = PARAM_KEYS[skill]
+    if not isinstance(d, Mapping) or set(d) != {key}:
+        raise InputError(f"{skill} takes params {{{key!r}: ...}}, got {describe(d)}")
+    return d[key]
+
+
+@dataclass(frozen=True)
+class PushParams:
+    """A push request: move the object ``PUSH_STEP`` metres along ``direction``.
+
+    Args:
+        direction: heading on the table, radians, world frame (any value; wrapped when checked).
+    """
+
+    direction: float
+    skill: ClassVar[SkillName] = "push"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "direction", as_finite("push direction (radians)", self.direction))
+
+    def as_dict(self) -> dict[str, float]:
+        """``{"direction": rad}``, the dict form."""
+        return {"direction": self.direction}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, float]) -> PushParams:
+        """From ``{"direction": rad}``; :class:`InputError` for other keys or a bad value."""
+        return cls(_only_value("push", d))  # checked in __post_init__
+
+
+@dataclass(frozen=True)
+class SpinParams:
+    """A spin request: turn the object by ``angle`` about the vertical through its centre of mass.
+
+    Args:
+        angle: radians, signed, counter-clockwise positive about world z; ``15 <= |angle| <= 45`` degrees.
+    """
+
+    angle: float
+    skill: ClassVar[SkillName] = "spin"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "angle", _spin_angle(self.angle))
+
+    def as_dict(self) -> dict[str, float]:
+        """``{"angle": rad}``, the dict form."""
+        return {"angle": self.angle}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, float]) -> SpinParams:
+        """From ``{"angle": rad}``; :class:`InputError` for other keys or a bad value."""
+        return cls(_only_value("spin", d))
+
+
+@dataclass(frozen=True)
+class RollParams:
+    """A roll request: tip the object into resting state ``target``.
+
+    Args:
+        target: index into ``obj.resting_states`` of a state one roll away (checked against the object when used).
+    """
+
+    target: int
+    skill: ClassVar[SkillName] = "roll"
+
+    def __post_init__(self) -> None:
+        if not is_whole(self.target):
+            raise InputError(f"roll target must be a resting-state index, got {describe(self.target)}")
+        object.__setattr__(self, "target", as_whole("roll target (resting-state index)", self.target))
+
+    def as_dict(self) -> dict[str, int]:
+        """``{"target": index}``, the dict form."""
+        return {"target": self.target}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, int]) -> RollParams:
+        """From ``{"target": index}``; :class:`InputError` for other keys or a bad value."""
+        return cls(_only_value("roll", d))
+
+
+SkillParams: TypeAlias = PushParams | RollParams | SpinParams
+# What every parameter argument takes: a typed value, today's dict, or None (the seed's objective).
+ParamsLike: TypeAlias = PushParams | RollParams | SpinParams | Mapping[str, float] | None
+PARAMS_TYPES: dict[str, type[PushParams] | type[RollParams] | type[SpinParams]] = {
+    "push": PushParams, "roll": RollParams, "spin": SpinParams}
+
+
+@overload
+def as_params(skill: str, value: None) -> None: ...
+
+
+@overload
+def as_params(skill: str, value: SkillParams | Mapping[str, float]) -> dict[str, float]: ...
+
+
+def as_params(skill: str, value: ParamsLike) -> dict[str, float] | None:
+    """``value`` in the form :func:`check` takes: ``None``, or a parameter dict (a copy; checked by :func:`check`).
+
+    ``value``: ``None``, a dict (``{"direction": rad}`` ...) or the skill's typed value (:class:`PushParams` ...).
+    Raises :class:`InputError` for an unknown skill, another skill's typed value or anything else.
+    """
+    cls = PARAMS_TYPES.get(skill)
+    if cls is None:
+        raise InputError(f"unknown skill {describe(skill)}; expected one of {SKILLS}")
+    if value is None:
+        return None
+    if isinstance(value, cls):
+        return value.as_dict()
+    if isinstance(value, (PushParams, RollParams, SpinParams)):
+        raise InputError(f"{skill} params must be a {cls.__name__} or a dict, got {value!r}")
+    if isinstance(value, Mapping):
+        return dict(value)
+    raise InputError(f"{skill} params must be a dict, a {cls.__name__} or None, got {describe(value)}")
 
 
 def roll_targets(obj: ObjectModel, state: int) -> list[int]:
@@ -64,24 +200,22 @@ def roll_targets(obj: ObjectModel, state: int) -> list[int]:
     return out
 
 
-def check(skill: str, params, obj: ObjectModel | None = None, state: int | None = None) -> dict | None:
+def check(skill: str, params: ParamsLike, obj: ObjectModel | None = None, state: int | None = None) -> dict | None:
     """Validated, normalised parameters (or ``None``); raises :class:`InputError` otherwise.
 
-    ``obj`` and ``state`` (the current resting state) are needed to check a roll target.
+    ``params``: a dict, a typed value (:class:`PushParams`, :class:`SpinParams`, :class:`RollParams`) or ``None``
+    (:func:`as_params`). ``obj`` and ``state`` (the current resting state) are needed to check a roll target.
     """
     if params is None:
         return None
-    if not isinstance(params, dict):
-        raise InputError(f"{skill} params must be a dict or None, got {params!r}")
-    key = {"push": "direction", "spin": "angle", "roll": "target"}.get(skill)
-    if key is None:
-        raise InputError(f"unknown skill {skill!r}")
+    params = as_params(skill, params)
+    key = PARAM_KEYS[skill]  # as_params refused an unknown skill
     if set(params) != {key}:
-        raise InputError(f"{skill} takes params {{{key!r}: ...}}, got {params!r}")
+        raise InputError(f"{skill} takes params {{{key!r}: ...}}, got {describe(params)}")
     value = params[key]
     if skill == "roll":
         if not is_whole(value):
-            raise InputError(f"roll target must be a resting-state index, got {value!r}")
+            raise InputError(f"roll target must be a resting-state index, got {describe(value)}")
         if obj is not None:
             n = len(obj.resting_states)
             if not 0 <= value < n:
@@ -90,13 +224,9 @@ def check(skill: str, params, obj: ObjectModel | None = None, state: int | None 
                 raise InputError(f"resting state {value} of {obj.name} is not one roll away from state {state} "
                                  f"(one roll away: {roll_targets(obj, state)})")
         return {"target": int(value)}
-    value = as_finite(f"{skill} {key} (radians)", value)
     if skill == "push":
-        return {"direction": wrap_angle(value)}
-    if not SPIN_MIN - 1e-9 <= abs(value) <= SPIN_MAX + 1e-9:
-        raise InputError(f"spin angle must be between {math.degrees(SPIN_MIN):.0f} and {math.degrees(SPIN_MAX):.0f} "
-                         f"degrees either way, got {math.degrees(value):.1f} deg (chain spins for more)")
-    return {"angle": value}
+        return {"direction": wrap_angle(as_finite("push direction (radians)", value))}
+    return {"angle": _spin_angle(value)}
 
 
 def sample(skill: str, rng: np.random.Generator, obj: ObjectModel, state: int, p_params: float) -> dict | None:

@@ -5,10 +5,13 @@
     push.success_probability(sim, {"direction": 0.0})           # learned P(success), no physics run
     outcome = push.execute(sim, {"direction": 0.0})             # Outcome with .success
     contact, motion = push.act(sim, {"direction": 0.0})         # what the policy would do
+    push.execute(sim, PushParams(direction=0.0))                # the same request, typed
 
 Parameters (:mod:`primitives.params`): push ``{"direction": rad}`` (world heading), spin
-``{"angle": rad}`` (signed, 15-45 deg), roll ``{"target": state index}`` (one roll away); ``None`` is
-the seed's objective. ``Outcome.success`` applies the matching criterion (:func:`primitives.rewards.success`).
+``{"angle": rad}`` (signed, 15-45 deg), roll ``{"target": state index}`` (one roll away), or the same as
+:class:`~primitives.params.PushParams`, :class:`~primitives.params.SpinParams`,
+:class:`~primitives.params.RollParams`; ``None`` is the seed's objective. ``Outcome.success`` applies the matching
+criterion (:func:`primitives.rewards.success`).
 The policy acts greedily, so ``act`` and ``execute`` are deterministic for a given cloud.
 
 **Frame search** (:mod:`primitives.frames`): with a :class:`~primitives.frames.FrameSearch`, the skill looks at
@@ -37,7 +40,8 @@ from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.frames import FrameSearch, reframe_obs, shipped_frame_search  # noqa: F401 (re-exported)
 from primitives.networks import HybridActorCritic
-from primitives.observation import PRIMITIVES, SkillObservation, skill_observation
+from primitives.observation import SkillObservation, skill_observation
+from primitives.params import SKILLS, ParamsLike, SkillName, as_params
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
@@ -49,10 +53,10 @@ UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact
 class Skill:
     """A trained primitive acting greedily on a simulator's point cloud, with its success model."""
 
-    def __init__(self, name: str, model: HybridActorCritic, n_points: int = 256,
+    def __init__(self, name: SkillName, model: HybridActorCritic, n_points: int = 256,
                  success_weights: str | os.PathLike | None = None, frame_search: FrameSearch | None = None,
                  searched_weights: str | os.PathLike | None = None):
-        self.name = name
+        self.name: SkillName = name
         self.model = model
         # The clouds the policy was trained on (its weights' metadata): what a simulator should show it.
         self.sensor: str = getattr(model, "sensor", "cameras")
@@ -63,19 +67,20 @@ class Skill:
         self._searched_weights = searched_weights
         self._searched: SuccessModel | None = None
 
-    def frames(self, params) -> np.ndarray:
+    def frames(self, params: ParamsLike) -> np.ndarray:
         """The goal frames this skill tries for (checked) ``params``: ``(m, 3, 3)``, the identity first."""
-        return (FrameSearch() if self.frame_search is None else self.frame_search).frames(self.name, params)
+        frames = FrameSearch() if self.frame_search is None else self.frame_search
+        return frames.frames(self.name, as_params(self.name, params))
 
-    def _observe_rated(self, sim: Simulator, params=None) -> tuple[SkillObservation, float | None]:
+    def _observe_rated(self, sim: Simulator, params: ParamsLike = None) -> tuple[SkillObservation, float | None]:
         """:meth:`observe` and, where frames were searched, the calibrated rating of the chosen one."""
-        seen = skill_observation(sim, self.name, params, self.n_points)
+        seen = skill_observation(sim, self.name, as_params(self.name, params), self.n_points)
         if self.frame_search is None or not self.frame_search.searches(self.name, seen.params):
             return seen, None
         seen, p = self.frame_search.select(self.name, seen, self.success_model.predict, sim)
         return seen, float(self.frame_search.calibrate(p, seen.params is not None))
 
-    def observe(self, sim: Simulator, params=None) -> SkillObservation:
+    def observe(self, sim: Simulator, params: ParamsLike = None) -> SkillObservation:
         """Cloud, the policy's observation, the checked params and the goal frame (raises InputError).
 
         With a frame search, the goal frame is the free frame the success model rates likeliest (for the seed's
@@ -89,12 +94,12 @@ class Skill:
         idx, motion, _ = greedy_action(self.model, seen.obs, allowed)
         return seen.points[idx], seen.normals[idx], seen.motion_to_world(motion)
 
-    def act(self, sim: Simulator, params=None) -> tuple[np.ndarray, np.ndarray]:
+    def act(self, sim: Simulator, params: ParamsLike = None) -> tuple[np.ndarray, np.ndarray]:
         """The contact point (world, metres) and world-frame motion in [-1, 1]^3 the policy picks."""
         contact, _, motion = self._decide(self.observe(sim, params))
         return contact, motion
 
-    def execute(self, sim: Simulator, params=None) -> Outcome:
+    def execute(self, sim: Simulator, params: ParamsLike = None) -> Outcome:
         """Act and execute; ``Outcome.success``: the criterion for ``params`` was met (and the sample valid).
 
         With the arm, a contact it cannot reach (:class:`ReachabilityError`, raised before any physics) or
@@ -141,10 +146,11 @@ class Skill:
             self._searched = SuccessModel(self.model, load_success_net(self.name, self._searched_weights))
         return self._searched
 
-    def success_probability(self, sim: Simulator, params=None) -> float:
+    def success_probability(self, sim: Simulator, params: ParamsLike = None) -> float:
         """Predicted probability that ``execute(sim, params)`` succeeds now (no physics is run)."""
         if self.searched_model is not None:
-            return float(self.searched_model.predict(skill_observation(sim, self.name, params, self.n_points).obs))
+            seen = skill_observation(sim, self.name, as_params(self.name, params), self.n_points)
+            return float(self.searched_model.predict(seen.obs))
         seen, p = self._observe_rated(sim, params)
         return float(self.success_model.predict(seen.obs)) if p is None else p
 
@@ -164,7 +170,7 @@ class Skill:
         return self.frame_search.calibrate(p.reshape(*obs.shape[:-2], len(frames)).max(axis=-1), parameterised)
 
 
-def load_skill(name: str, weights: str | os.PathLike | None = None,
+def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
                success_weights: str | os.PathLike | None = None,
                frame_search: FrameSearch | bool = True, searched: bool = True,
                weights_dir: str | os.PathLike | None = None) -> Skill:
@@ -181,8 +187,8 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
     stand in for the shipped ones, e.g. a candidate set under ``weights/candidates/``. A folder without
     ``{name}.pt`` leaves that skill on the shipped files. Not combined with ``weights`` or ``success_weights``.
     """
-    if name not in PRIMITIVES:
-        raise InputError(f"unknown skill {name!r}; expected one of {PRIMITIVES}")
+    if name not in SKILLS:
+        raise InputError(f"unknown skill {name!r}; expected one of {SKILLS}")
     if weights_dir is not None and (weights is not None or success_weights is not None):
         raise InputError("give weights_dir, or weights and success_weights, not both")
     shipped = frame_search is True and weights is None and success_weights is None
@@ -209,14 +215,14 @@ def load_skill(name: str, weights: str | os.PathLike | None = None,
                  searched_weights=searched_weights)
 
 
-def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[str, Skill]:
+def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[SkillName, Skill]:
     """All three skills, ``{"push": Skill, "roll": ..., "spin": ...}``: the shipped ones, or with ``weights_dir`` each
     skill whose ``{name}.pt`` is in that folder from the folder's files (:func:`load_skill`), the others shipped.
 
     Raises:
         InputError: ``weights_dir`` is not a folder, or a policy in it has no success model beside it.
     """
-    return {name: load_skill(name, weights_dir=weights_dir) for name in PRIMITIVES}
+    return {name: load_skill(name, weights_dir=weights_dir) for name in SKILLS}
 
 
 def skills_sensor(skills: dict[str, Skill]) -> str:

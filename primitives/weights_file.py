@@ -32,11 +32,11 @@ import torch
 
 from affordplan.errors import WeightsError
 from affordplan.log import cli_logging
+from primitives.params import SKILLS
 
 FORMAT = "affordplan-weights"
 FORMAT_VERSION = 1
 KINDS = ("policy", "success", "checkpoint")
-SKILLS = ("push", "roll", "spin")
 _WHAT = {"policy": "weights", "success": "success model", "checkpoint": "checkpoint"}  # for messages
 SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one place that knows where they live
 

@@ -48,3 +48,23 @@ def test_yaw_symmetric_must_be_a_bool():
     with pytest.raises(GoalError, match="yaw_symmetric must be True or False"):
         ap.Goal(xy=(0.6, 0.0), yaw=0.0, yaw_symmetric="yes")
     assert ap.Goal(xy=(0.6, 0.0), yaw_symmetric=np.bool_(False)).yaw_symmetric is False
+
+
+def test_from_degrees_is_the_goal_in_radians():
+    assert ap.Goal.from_degrees((0.6, 0.0), 90.0, 1, xy_tol=0.02, yaw_tol_deg=10.0) == ap.Goal(
+        xy=(0.6, 0.0), yaw=math.radians(90.0), resting_state=1, xy_tol=0.02, yaw_tol=math.radians(10.0))
+    assert ap.Goal.from_degrees([0.6, -0.1]) == ap.Goal(xy=(0.6, -0.1))  # no yaw; 15 deg tolerance, as Goal's
+    assert ap.Goal.from_degrees((0.6, 0.0), -30, yaw_symmetric=False) == ap.Goal(
+        xy=(0.6, 0.0), yaw=math.radians(-30.0), yaw_symmetric=False)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"yaw_deg": True}, "yaw_deg"), ({"yaw_deg": float("nan")}, "yaw_deg"), ({"yaw_deg": "90"}, "yaw_deg"),
+    ({"yaw_tol_deg": math.inf}, "yaw_tol_deg"), ({"yaw_tol_deg": 0.0}, "yaw_tol"), ({"xy_tol": -0.01}, "xy_tol"),
+    ({"resting_state": 1.5}, "resting_state"), ({"yaw_symmetric": "no"}, "yaw_symmetric"),
+])
+def test_from_degrees_keeps_the_goal_checks(kwargs, words):
+    with pytest.raises(GoalError, match=words):
+        ap.Goal.from_degrees((0.6, 0.0), **kwargs)
+    with pytest.raises(GoalError, match="xy"):
+        ap.Goal.from_degrees((0.6, float("nan")))

@@ -40,7 +40,12 @@ def import_graph() -> nx.DiGraph:
     graph = nx.DiGraph()
     for name, path in modules.items():
         graph.add_node(name)
-        for node in ast.walk(ast.parse(path.read_text())):
+        tree = ast.parse(path.read_text())
+        type_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If) and _is_type_checking(block.test)
+                     for stmt in block.body for n in ast.walk(stmt)}
+        for node in ast.walk(tree):
+            if id(node) in type_only:  # ``if TYPE_CHECKING:`` imports never run
+                continue
             if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
                 subs = [f"{node.module}.{a.name}" for a in node.names]
                 targets = subs if all(t in modules for t in subs) else [node.module]
@@ -50,6 +55,11 @@ def import_graph() -> nx.DiGraph:
                 continue
             graph.add_edges_from((name, t) for t in targets if t in modules and t != name)
     return graph
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
 def _layer(module: str) -> int:

@@ -141,3 +141,79 @@ def test_goal_frame_motion_reaches_the_world():
     out = sim.execute(seen.points[i], seen.motion_to_world([1.0, 0.0, 0.0]), normal=seen.normals[i])
     moved = out.pose_after[:3, 3] - out.pose_before[:3, 3]
     assert 0.04 < moved[1] < 0.12 and abs(moved[0]) < 0.02  # along world +y, the asked direction
+
+
+# ---------------------------------------------------------- typed parameters (PushParams, SpinParams, RollParams)
+def test_skills_are_listed_once_in_one_order():
+    from typing import get_args
+
+    assert params.SKILLS == ("push", "roll", "spin") == get_args(params.SkillName)
+    assert tuple(params.PARAM_KEYS) == tuple(params.PARAMS_TYPES) == params.SKILLS
+    assert all(params.PARAMS_TYPES[name].skill == name for name in params.SKILLS)
+
+
+def test_typed_params_round_trip_and_check_like_their_dicts():
+    cube = ap.load_object("cube")
+    target = params.roll_targets(cube, 0)[0]
+    pairs = [("push", params.PushParams(direction=3 * math.pi), {"direction": 3 * math.pi}),
+             ("spin", params.SpinParams(angle=-math.radians(30)), {"angle": -math.radians(30)}),
+             ("roll", params.RollParams(target=np.int64(target)), {"target": target})]
+    for skill, typed, d in pairs:
+        assert typed.as_dict() == d and type(typed).from_dict(d) == typed
+        assert params.as_params(skill, typed) == params.as_params(skill, d) == d
+        assert params.check(skill, typed, cube, 0) == params.check(skill, d, cube, 0)
+    assert params.check("push", params.PushParams(3 * math.pi))["direction"] == pytest.approx(-math.pi)
+    assert type(params.RollParams(np.int64(2)).target) is int
+    assert params.as_params("push", None) is None and params.check("push", None) is None
+    opposite = next(t for t in range(1, 6) if t not in params.roll_targets(cube, 0))
+    with pytest.raises(InputError, match="not one roll away"):  # the object-dependent checks still apply
+        params.check("roll", params.RollParams(target=opposite), cube, 0)
+
+
+@pytest.mark.parametrize("make", [
+    lambda: params.PushParams(True), lambda: params.PushParams(float("nan")), lambda: params.PushParams("east"),
+    lambda: params.SpinParams(math.inf), lambda: params.SpinParams(math.radians(10)),
+    lambda: params.SpinParams(False), lambda: params.RollParams(1.0), lambda: params.RollParams(True),
+    lambda: params.RollParams(-1),
+    lambda: params.PushParams.from_dict({"angle": 0.2}), lambda: params.SpinParams.from_dict({}),
+    lambda: params.RollParams.from_dict({"target": 1, "extra": 2}), lambda: params.PushParams.from_dict(0.3),
+    lambda: params.as_params("spin", params.PushParams(0.1)), lambda: params.as_params("push", 0.3),
+    lambda: params.as_params("walk", {"direction": 0.1}), lambda: params.check("roll", params.SpinParams(0.5)),
+])
+def test_bad_typed_params_are_refused_with_input_errors(make):
+    with pytest.raises(InputError):
+        make()
+
+
+def _finger_sim(cube):
+    sim = ap.Simulator(cube, pusher="finger", seed=0, sensor="surface")
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.3)
+    return sim
+
+
+def test_a_skill_sees_and_does_the_same_for_a_typed_value_and_its_dict():
+    """Same sim state (a fresh seeded simulator each time: the cloud is drawn from its generator), same request in
+    either form: the same observation, action, rating and outcome."""
+    from primitives import load_skill
+
+    cube = ap.load_object("cube")
+    target = params.roll_targets(cube, 0)[0]
+    requests = [("push", params.PushParams(0.7), {"direction": 0.7}),
+                ("spin", params.SpinParams(-math.radians(30)), {"angle": -math.radians(30)}),
+                ("roll", params.RollParams(target), {"target": target})]
+    for name, typed, d in requests:
+        skill = load_skill(name)
+        seen_typed, seen_dict = skill.observe(_finger_sim(cube), typed), skill.observe(_finger_sim(cube), d)
+        assert seen_typed.params == seen_dict.params
+        assert np.array_equal(seen_typed.obs, seen_dict.obs)
+        assert np.array_equal(seen_typed.A_frame_world, seen_dict.A_frame_world)
+        assert skill.success_probability(_finger_sim(cube), typed) == skill.success_probability(_finger_sim(cube), d)
+    push = load_skill("push")
+    c1, m1 = push.act(_finger_sim(cube), params.PushParams(0.7))
+    c2, m2 = push.act(_finger_sim(cube), {"direction": 0.7})
+    assert np.array_equal(c1, c2) and np.array_equal(m1, m2)
+    out_typed = push.execute(_finger_sim(cube), params.PushParams(0.7))
+    out_dict = push.execute(_finger_sim(cube), {"direction": 0.7})
+    assert out_typed.success == out_dict.success and np.allclose(out_typed.pose_after, out_dict.pose_after)
+    with pytest.raises(InputError):
+        push.act(_finger_sim(cube), params.SpinParams(0.5))

@@ -13,6 +13,8 @@ import math
 import sys
 import textwrap
 
+from affordplan.robot import SKILLS
+
 EXAMPLES = """\
 examples:
   affordplan demo                          # the mug: flip upright, through the gap, turn; ./affordplan-demo/
@@ -144,7 +146,8 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
     log = (lambda text: print(text, file=sys.stderr, flush=True)) if args.log else None
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
                         max_primitives=args.max_primitives, progress=not args.json and not args.log,
-                        only=args.task, log=log, weights_dir=args.weights_dir, draw=args.draw)
+                        only=args.task, log=log, weights_dir=args.weights_dir, draw=args.draw,
+                        objects=args.objects)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -411,7 +414,7 @@ def build_parser() -> argparse.ArgumentParser:
     s2s.add_argument("--object", nargs="+", default=["cube"], help="catalogue names (default: cube)")
     s2s.add_argument("-n", type=_positive_int, default=100, help="primitives per object (default: %(default)s)")
     s2s.add_argument("--seed", type=_seed, default=0, help="random seed (default: %(default)s)")
-    s2s.add_argument("--skill", nargs="+", choices=["push", "roll", "spin"],
+    s2s.add_argument("--skill", nargs="+", choices=SKILLS,
                      help="compare the shipped skills' success instead (on held-out objects; -n draws each)")
     s2s.set_defaults(func=_cmd_bench_sim2sim)
 
@@ -424,7 +427,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  affordplan bench query --skill spin --weights-dir candidates/spin_cframe",
         formatter_class=_formatter,
     )
-    bq.add_argument("--skill", nargs="+", default=["push", "spin", "roll"], choices=["push", "spin", "roll"],
+    bq.add_argument("--skill", nargs="+", default=list(SKILLS), choices=SKILLS,
                     help="skills to time (default: all three)")
     bq.add_argument("--repeats", type=_positive_int, default=100, help="timed queries each (default: %(default)s)")
     bq.add_argument("--batch", type=_positive_int, default=32, help="queries per batch (default: %(default)s)")
@@ -441,8 +444,9 @@ def build_parser() -> argparse.ArgumentParser:
     bp = bench_sub.add_parser(
         "plan", help="plan-and-execute success on random tasks, affordplan vs greedy",
         description=_wrap("Random tasks (walls with gaps, blocks, face changes, goal yaw) on objects never "
-                          "trained on; prints success, median planning time, primitives and replans per task for "
-                          "each planner."),
+                          "trained on; prints success, planning time (median, max), primitives per task (mean, "
+                          "median, p90), replans, and the plan-level calibration of the predicted p_success "
+                          "(Brier, bins) for each planner."),
         epilog="examples:\n  affordplan bench plan --tasks 50 --sim arm --seed 0\n"
                "  affordplan bench plan --tasks 10 --sim finger --planner affordplan --json\n"
                "  affordplan bench plan --seed 3 --task 22 42 --planner affordplan --log   # why they failed\n"
@@ -467,6 +471,9 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--draw", type=_nonnegative_int, default=0, metavar="K",
                     help="run the same tasks with the planner's and the simulator's random numbers drawn afresh "
                          "(K > 0; 0, the default, is the standard run): how far outcomes move by chance alone")
+    bp.add_argument("--objects", default="procedural", choices=["procedural", "household", "mixed"],
+                    help="the tasks' objects: the procedural test split, HACMan's 25 unseen household meshes, or "
+                         "the two by turns (default: %(default)s)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     _register_robustness(bench_sub)

@@ -228,6 +228,11 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
         simulator.on_chunk = simulator.after_primitive = None
     t_out = time.perf_counter()
     echo(str(execution))
+    if plan.kind == "affordplan":
+        odds = plan.odds(max_primitives)
+        echo(f"predicted: the goal reached with p_success {odds.p_success:.2f} within {max_primitives} primitives, "
+             f"about {odds.expected_primitives:.1f} of them; happened: "
+             f"{'reached' if execution.success else 'not reached'} after {execution.n_primitives}")
 
     xy_error, yaw_error, state_ok = scene.goal.errors(obj, execution.final_pose)
     run = SceneRun(scene, plan, execution, xy_error, yaw_error, state_ok, obj.classify(execution.final_pose),
@@ -329,6 +334,7 @@ def summary(run: SceneRun, obj: ObjectModel) -> dict:
     return {
         "scene": run.scene.as_dict(),
         "plan": {"kind": plan.kind, "route": [int(r) for r in plan.route], "p_success": _finite(plan.p_success),
+                 "expected_primitives": _finite(plan.expected_primitives), "p_steps": _finite(plan.p_steps),
                  "planning_time_s": plan.planning_time,
                  "steps": [{"skill": s.skill, "params": _plain(s.params), "p_success": _finite(s.p_success)}
                            for s in plan.steps]},

@@ -40,7 +40,6 @@ from affordplan.world import Box
 TOP_LEVEL = ("name", "description", "object", "size", "start", "goal", "obstacles")
 START_FIELDS = ("resting_state", "xy", "yaw", "yaw_deg")
 GOAL_FIELDS = ("xy", "yaw", "yaw_deg", "resting_state", "xy_tol", "yaw_tol", "yaw_tol_deg", "yaw_symmetric")
-BOX_FIELDS = ("center", "size", "yaw", "yaw_deg")
 MAX_FILE_BYTES = 1_000_000  # a scene is a few hundred bytes; this bounds reading and parsing
 MAX_DEPTH = 8  # nesting of mappings and lists; a scene needs 3
 
@@ -319,15 +318,10 @@ def _goal(value: Any, source: str) -> Goal:
 
 def _box(value: Any, source: str, name: str) -> Box:
     d = _mapping(value, source, name)
-    _known(d, BOX_FIELDS, source, name)
-    for key in ("center", "size"):
-        if key not in d:
-            raise InputError(f"{source}: {name}: missing field '{key}' (metres)")
-    center = _numbers(d["center"], 2, source, f"{name}.center", "metres")
-    size = _numbers(d["size"], 3, source, f"{name}.size", "metres: sx, sy, sz")
-    if min(size) <= 0:
-        raise InputError(f"{source}: {name}.size must be positive, got {list(size)}")
-    return Box(center=center, size=size, yaw=_angle(d, "yaw", source, name, 0.0))
+    try:
+        return Box.from_dict(d, name)  # the core's rules, shared with affordplan.plan(obstacles=[dict, ...])
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
 
 
 __all__ = ["DEMO_SCENE", "Scene", "demo_scene", "load_scene", "parse_scene"]

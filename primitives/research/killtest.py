@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from affordplan.log import cli_logging
+from affordplan.robot import SKILLS as PRIMITIVES
 
 logger = logging.getLogger(__name__)
 
@@ -355,7 +356,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  python -m primitives.research.killtest spin --kills 3 --workers 1 --out /tmp/kt --overwrite --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("primitive", choices=["push", "roll", "spin"])
+    p.add_argument("primitive", choices=PRIMITIVES)
     p.add_argument("--kills", type=int, default=5, help="stops before the final run (default: %(default)s)")
     p.add_argument("--signals", nargs="+", choices=("KILL", "INT", "TERM"), default=["KILL"],
                    help="the signal of each stop, in turn (default: %(default)s)")

@@ -27,7 +27,8 @@ from tqdm import tqdm
 from affordplan import versions, versions_text
 from affordplan.errors import AffordplanError, InputError
 from affordplan.goal import Goal
-from affordplan.objects.model import ObjectModel, random_object
+from affordplan.objects import housekeep
+from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.world import Box, Workspace
 from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, inflated_footprints, make_checkers
@@ -39,6 +40,9 @@ OBJECTS_PER_SEED = 1000
 # Goal states in which fewer random drops come to rest are reported apart (an ellipsoid on its tip: the roll
 # into them, and every push there, rarely succeeds); they stay in the tasks and in the success rate.
 RARE_GOAL_STATE = 0.05
+# What the tasks' objects are: the procedural test split, HACMan's unseen household meshes (never trained on,
+# housekeep.names("unseen")), or the two by turns (even tasks procedural, odd ones household).
+OBJECT_SETS = ("procedural", "household", "mixed")
 
 
 @dataclass
@@ -67,6 +71,11 @@ class TaskResult:
     # more than the goal's tolerance) or "yaw" (in place, turned wrong); "" on success
     missed: str = ""
     task: int = -1  # index of the task in its seed's draw (object OBJECTS_PER_SEED * seed + task)
+    # the first plan's predicted odds (Plan.p_success, Plan.expected_primitives); nan for greedy or no plan
+    p_success: float = float("nan")
+    expected_primitives: float = float("nan")
+    max_planning_time: float = float("nan")  # the longest of the first plan and the replans, seconds
+    object_name: str = ""
 
 
 @dataclass
@@ -79,9 +88,15 @@ class BenchReport:
         if not rs:
             return {}
         rare = [r for r in rs if r.goal_state_probability < RARE_GOAL_STATE]
+        primitives = [r.primitives for r in rs]
+        longest = [r.max_planning_time for r in rs if np.isfinite(r.max_planning_time)]
         return dict(planner=planner, tasks=len(rs), success=float(np.mean([r.success for r in rs])),
                     median_planning_time_s=float(np.median([r.planning_time for r in rs])),
-                    mean_primitives=float(np.mean([r.primitives for r in rs])),
+                    max_planning_time_s=float(max(longest)) if longest else float("nan"),
+                    mean_primitives=float(np.mean(primitives)),
+                    median_primitives=float(np.median(primitives)),
+                    p90_primitives=float(np.percentile(primitives, 90)),
+                    calibration=plan_calibration([r.p_success for r in rs], [r.success for r in rs]),
                     mean_replans=float(np.mean([r.replans for r in rs])),
                     success_by_scene={s: float(np.mean([r.success for r in rs if r.scene == s]))
                                       for s in sorted({r.scene for r in rs})},
@@ -90,17 +105,26 @@ class BenchReport:
 
     def report(self) -> str:
         lines = ["versions: " + versions_text(),
-                 f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median)':>19s} "
-                 f"{'primitives/task':>16s} {'replans/task':>13s}  by scene; goal state rarer than "
-                 f"{RARE_GOAL_STATE:.0%} of drops"]
+                 f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median / max)':>25s} "
+                 f"{'primitives (mean / median / p90)':>33s} {'replans/task':>13s}  by scene; goal state rarer "
+                 f"than {RARE_GOAL_STATE:.0%} of drops"]
         summaries = [self.summary(name) for name in dict.fromkeys(r.planner for r in self.results)]
         for s in summaries:
             scenes = ", ".join(f"{k} {v:.2f}" for k, v in s["success_by_scene"].items())
             rare = s["rare_goal_states"]
             rare_text = f"{rare['reached']}/{rare['tasks']}" if rare["tasks"] else "none"
             lines.append(f"{s['planner']:10s} {s['tasks']:5d} {s['success']:8.2f} "
-                         f"{1e3 * s['median_planning_time_s']:16.0f} ms {s['mean_primitives']:16.1f} "
+                         f"{1e3 * s['median_planning_time_s']:10.0f} / {1e3 * s['max_planning_time_s']:6.0f} ms "
+                         f"{s['mean_primitives']:17.1f} / {s['median_primitives']:4.0f} / {s['p90_primitives']:4.0f} "
                          f"{s['mean_replans']:13.1f}  {scenes}; rare goal {rare_text}")
+        for s in summaries:
+            cal = s["calibration"]
+            if cal["plans"]:
+                bins = ", ".join(f"[{b['lo']:.1f}, {b['hi']:.1f}): {b['predicted']:.2f} vs {b['reached']:.2f} "
+                                 f"({b['plans']})" for b in cal["bins"])
+                lines.append(f"{s['planner']} plan-level calibration, {cal['plans']} plans: Brier {cal['brier']:.3f}, "
+                             f"mean predicted {cal['mean_predicted']:.2f} vs reached {cal['reached']:.2f}; "
+                             f"by predicted p_success: {bins}")
         for s in summaries:
             name, missed = s["planner"], s["failures"]
             if missed:
@@ -129,9 +153,22 @@ def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...
     return ()
 
 
-def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Workspace()) -> tuple[Task, ObjectModel]:
-    """A random task on test object ``index`` whose start and goal are free (resampled until they are)."""
-    obj = random_object(index, "test")
+def task_object(index: int, objects: str = "procedural") -> ObjectModel:
+    """Task ``index``'s object (:data:`OBJECT_SETS`): procedural test object ``index``, or unseen household mesh
+    ``index`` (cycling through the 25); ``"mixed"`` takes the household one for odd indices."""
+    if objects not in OBJECT_SETS:
+        raise InputError(f"objects must be one of {OBJECT_SETS}, got {str(objects)[:40]!r}")
+    if objects == "household" or (objects == "mixed" and index % 2):
+        names = housekeep.names("unseen")
+        return load_object(f"housekeep/{names[index % len(names)]}")
+    return random_object(index, "test")
+
+
+def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Workspace(),
+              objects: str = "procedural") -> tuple[Task, ObjectModel]:
+    """A random task on object ``index`` of ``objects`` (:func:`task_object`) whose start and goal are free
+    (resampled until they are)."""
+    obj = task_object(index, objects)
     states = obj.resting_states
     probs = np.array([s.probability for s in states])
     radius = max(float(np.linalg.norm(obj.mesh.extents[:2])) / 2, 0.03)
@@ -158,6 +195,25 @@ def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Works
     raise AffordplanError(f"could not place a free start and goal on test object {index}")
 
 
+def plan_calibration(predicted: Sequence[float], reached: Sequence[bool], bins: int = 5) -> dict:
+    """Plan-level calibration of predicted ``p_success`` against whether the goal was reached (plans without a
+    prediction, nan, are left out): the Brier score, and per equal-width bin the mean prediction and the share
+    reached."""
+    p = np.asarray(predicted, dtype=float)
+    y = np.asarray(reached, dtype=float)
+    keep = np.isfinite(p)
+    p, y = p[keep], y[keep]
+    if not len(p):
+        return dict(plans=0, brier=float("nan"), mean_predicted=float("nan"), reached=float("nan"), bins=[])
+    edges = np.linspace(0.0, 1.0, bins + 1)
+    which = np.clip(np.digitize(p, edges) - 1, 0, bins - 1)
+    rows = [dict(lo=float(edges[b]), hi=float(edges[b + 1]), plans=int(np.sum(which == b)),
+                 predicted=float(np.mean(p[which == b])), reached=float(np.mean(y[which == b])))
+            for b in range(bins) if np.any(which == b)]
+    return dict(plans=int(len(p)), brier=float(np.mean((p - y) ** 2)), mean_predicted=float(np.mean(p)),
+                reached=float(np.mean(y)), bins=rows)
+
+
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
              max_primitives: int, time_limit: float, log: Callable[[str], None] | None = None) -> TaskResult:
     """Plan and execute ``task`` with one planner; ``log``, when given, receives the first plan and the
@@ -181,8 +237,12 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
     goal = task.goal
     xy_error, yaw_error, state_ok = goal.errors(obj, ex.final_pose)
     missed = "" if ex.success else "state" if not state_ok else "position" if xy_error > goal.xy_tol else "yaw"
+    longest = max(ex.plan_times) if planner_name == "affordplan" and ex.plan_times else float("nan")
+    predicted = (float(p.p_success), float(p.expected_primitives)) if planner_name == "affordplan" else (
+        float("nan"), float("nan"))
     return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal,
-                      float(xy_error), float(yaw_error), missed)
+                      float(xy_error), float(yaw_error), missed, p_success=predicted[0],
+                      expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name)
 
 
 def _describe(task: Task) -> str:
@@ -206,7 +266,8 @@ def task_seed(seed: int, task: int | None, draw: int = 0) -> int:
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
                only: Sequence[int] | None = None, log: Callable[[str], None] | None = None,
-               weights_dir: str | os.PathLike | None = None, draw: int = 0) -> BenchReport:
+               weights_dir: str | os.PathLike | None = None, draw: int = 0, objects: str = "procedural"
+               ) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring).
 
     ``draw``: 0 runs the standard bench; ``k > 0`` runs the same tasks (objects, scenes, starts, goals) with the
@@ -217,6 +278,8 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     ``weights_dir``: run the skills from this folder's files instead of the shipped ones
     (:func:`primitives.skills.load_skills`; a skill without files there stays shipped), e.g. to bench a
     candidate set of weights before shipping it.
+
+    ``objects``: the tasks' objects, one of :data:`OBJECT_SETS` (:func:`task_object`).
 
     ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
     run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
@@ -235,7 +298,8 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     report = BenchReport(draw=draw)
     bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")
     for i in range(max(wanted) + 1):
-        task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i)  # drawn in order: task i is the same in any run
+        # drawn in order: task i is the same in any run
+        task, obj = make_task(rng, OBJECTS_PER_SEED * seed + i, objects=objects)
         if i not in wanted:
             continue
         predictor = Predictor(obj, skills=skills, seed=task_seed(seed, None, draw))

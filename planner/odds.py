@@ -1,0 +1,153 @@
+"""A plan's odds under closed-loop execution: the probability of reaching the goal within a primitive budget, and
+the primitives it is expected to spend.
+
+Closed-loop execution (:mod:`planner.execute`) observes after every primitive and replans from where the object
+lies, so a step that misses its own criterion is not the end of the plan: it costs the primitives that put the
+object back on a way to the goal. The model here takes that literally. Step ``i`` of a plan is retried until it
+succeeds, each try succeeding with the step's predicted probability ``q_i`` independently of the others, so it
+takes ``N_i ~ Geometric(q_i)`` primitives; the plan reaches the goal within a budget ``B`` when
+``N_1 + ... + N_n <= B``. The distribution of that sum is computed exactly (a convolution of truncated geometric
+distributions, ``O(n B^2)``, no sampling), so a plan's odds are deterministic.
+
+What the model leaves out, and what it is checked against: a failed primitive may leave the object worse off than
+before (one retry is not always enough) or better (a push that fell short still moved it), and a step the executor
+gives up on is replaced by another. ``affordplan bench plan`` compares the predicted odds with what happened
+(calibration bins and the Brier score).
+
+**Monte Carlo through the outcome model** (:func:`mc_odds`): a strict criterion undersells a step, since a push that
+moved 3.5 cm did most of its job and the executor replans from there. :func:`mc_odds` instead draws what each
+primitive achieves from the skill's outcome model (:class:`primitives.outcome_model.OutcomeModel`: the share of the
+asked effect, given the step's strict probability) and counts the primitives until the plan's effect is achieved.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from affordplan.checks import as_whole
+from affordplan.errors import InputError
+
+if TYPE_CHECKING:
+    from primitives.outcome_model import OutcomeModel
+
+DEFAULT_BUDGET = 60  # primitives: Plan.execute's default max_primitives
+Q_FLOOR = 0.02  # a step rated below this is treated as this: the executor replaces a step that keeps failing
+
+
+@dataclass(frozen=True)
+class Odds:
+    """A plan's odds: ``p_success`` (probability of reaching the goal within ``budget`` primitives) and
+    ``expected_primitives`` (the mean primitives spent, counting a run that exhausts the budget as ``budget``)."""
+
+    p_success: float
+    expected_primitives: float
+    budget: int
+
+
+def primitives_pmf(step_probabilities: Sequence[float], budget: int) -> np.ndarray:
+    """``pmf[k]`` = P(the steps take exactly ``k`` primitives in all), ``k = 0 .. budget``; the mass beyond the
+    budget is ``1 - pmf.sum()``. Each step is retried until it succeeds, with success probability ``q_i`` per try
+    (clipped to ``[Q_FLOOR, 1]``)."""
+    budget = as_whole("budget", budget, 0, 100_000)
+    q = np.asarray(step_probabilities, dtype=float).reshape(-1)
+    if not np.all(np.isfinite(q)):
+        raise InputError("step probabilities must be finite numbers in [0, 1]")
+    if np.any(q < 0.0) or np.any(q > 1.0):
+        raise InputError(f"step probabilities must lie in [0, 1], got {np.round(q, 3).tolist()[:8]}")
+    q = np.clip(q, Q_FLOOR, 1.0)
+    pmf = np.zeros(budget + 1)
+    pmf[0] = 1.0
+    k = np.arange(1, budget + 1)
+    for qi in q:
+        tries = np.zeros(budget + 1)
+        tries[1:] = qi * (1.0 - qi) ** (k - 1)  # P(N = k), N >= 1
+        pmf = np.convolve(pmf, tries)[: budget + 1]
+    return pmf
+
+
+def plan_odds(step_probabilities: Sequence[float], budget: int = DEFAULT_BUDGET) -> Odds:
+    """The :class:`Odds` of a plan whose steps succeed with ``step_probabilities`` per try (module docstring)."""
+    pmf = primitives_pmf(step_probabilities, budget)
+    reach = float(pmf.sum())
+    spent = float(np.dot(np.arange(len(pmf)), pmf) + (1.0 - reach) * budget)
+    return Odds(p_success=min(max(reach, 0.0), 1.0), expected_primitives=spent, budget=int(budget))
+
+
+def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeModel], budget: int = DEFAULT_BUDGET,
+            seed: int = 0, n: int = 2000) -> Odds:
+    """The :class:`Odds` of a plan by Monte Carlo through the skills' outcome models.
+
+    ``steps``: the plan's ``(skill, strict p)`` in order; ``models``: an outcome model per skill used, anything with
+    ``sample_progress(p, rng, n)`` (:class:`primitives.outcome_model.OutcomeModel`).
+
+    Model: every step asks for one unit of its skill's effect (a push 5 cm, a spin its angle, a roll its state).
+    Each of ``n`` runs spends primitives on its current step; a primitive draws a progress for that step's ``p``
+    (below 0 counts 0: the planner replans from where the object is); progress accumulates over a stretch of
+    consecutive steps of one skill, so a surplus carries over to the next step of the same skill (a push of 7 cm
+    covers 1.4 push steps) but not across a change of skill; a roll counts only when it reached its state (a
+    progress of at least 1 counts 1, less counts 0). ``p_success`` is the share of runs done within ``budget``
+    primitives, ``expected_primitives`` their mean, counting a run that is not done as ``budget``.
+
+    Each step's draws come from a pool of ``n`` samples of its model drawn once (``sample_progress(p, rng, n)``),
+    resampled by the runs; the result is deterministic for a ``seed`` (``np.random.default_rng``). Vectorised over
+    the runs: about a millisecond for a 10-step plan.
+
+    Raises:
+        InputError: a step that is not ``(skill, p)`` with ``p`` in [0, 1], a skill with no model, a bad budget
+            or ``n``.
+    """
+    budget = as_whole("budget", budget, 0, 100_000)
+    n = as_whole("n", n, 1, 10_000_000)
+    skills, q = [], []
+    for step in steps:
+        try:
+            skill, p = step
+            p = float(p)
+        except (TypeError, ValueError):
+            raise InputError(f"a step must be (skill, strict p), got {step!r:.60}") from None
+        if not (np.isfinite(p) and 0.0 <= p <= 1.0):
+            raise InputError(f"step probabilities must lie in [0, 1], got {p!r} for {skill!r}")
+        if skill not in models:
+            raise InputError(f"no outcome model for {skill!r} (models for {sorted(models)})")
+        skills.append(skill)
+        q.append(p)
+    m = len(skills)
+    if m == 0:
+        return Odds(p_success=1.0, expected_primitives=0.0, budget=int(budget))
+    rng = np.random.default_rng(seed)
+    pool = np.empty((m, n))
+    for i, (skill, p) in enumerate(zip(skills, q)):
+        draws = np.asarray(models[skill].sample_progress(p, rng, n), dtype=float).reshape(-1)
+        if len(draws) != n or not np.all(np.isfinite(draws)):
+            raise InputError(f"the {skill} outcome model gave {len(draws)} samples, not {n} finite ones")
+        pool[i] = (draws >= 1.0 - 1e-9).astype(float) if skill == "roll" else np.maximum(draws, 0.0)
+    # stretches of consecutive steps of one skill: every step's stretch start and end (exclusive)
+    start = np.zeros(m, dtype=np.int64)
+    for i in range(1, m):
+        start[i] = start[i - 1] if skills[i] == skills[i - 1] else i
+    end = np.empty(m, dtype=np.int64)
+    end[-1] = m
+    for i in range(m - 2, -1, -1):
+        end[i] = end[i + 1] if skills[i] == skills[i + 1] else i + 1
+    start, end = np.append(start, m), np.append(end, m)  # step m: done, absorbing
+    pool = np.vstack([pool, np.zeros((1, n))])
+    step = np.zeros(n, dtype=np.int64)  # each run's current step (m: done)
+    acc = np.zeros(n)  # progress accumulated in the run's current stretch
+    spent = np.full(n, budget, dtype=np.int64)
+    for t in range(1, budget + 1):
+        acc += pool[step, rng.integers(n, size=n)]
+        covered = start[step] + np.floor(acc + 1e-9).astype(np.int64)
+        finished = covered >= end[step]
+        step = np.where(finished, end[step], np.minimum(covered, end[step]))
+        acc[finished] = 0.0
+        newly = (step == m) & (spent == budget)
+        spent[newly] = t
+        if np.all(step == m):
+            break
+    done = step == m
+    # a run that finished on the budget's last primitive has spent == budget either way
+    return Odds(p_success=float(done.mean()), expected_primitives=float(spent.mean()), budget=int(budget))

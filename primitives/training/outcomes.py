@@ -1,0 +1,277 @@
+"""Collect what skill calls do, for the outcome model (:mod:`primitives.outcome_model`), and check that model.
+
+    python -m primitives.training.outcomes collect push --rollouts 600 --objects train+housekeep:training --seed 0 --out push_outcome.npz
+    python -m primitives.training.outcomes check push --model primitives/weights/push_outcome.npz --objects housekeep:unseen --rollouts 150 --seed 1
+
+**collect**: each rollout draws an object and a stable start as :mod:`primitives.training.evaluate` does (an object
+group of ``--objects`` uniformly, an object in it, a resting state by its probability, a position in the middle of
+the workspace and a yaw; :class:`primitives.training.env.EnvConfig`), builds a finger :class:`affordplan.Simulator`
+showing the skills' sensor (:func:`primitives.skills.skills_sensor`), draws a parameter as the planner asks them
+(push ``{"direction": U(-pi, pi)}``; spin ``{"angle": +-U(SPIN_MIN, SPIN_MAX)}``; roll a target among
+:func:`primitives.params.roll_targets`, the start skipped when there is none), asks the shipped skill's success
+model ``p = skill.success_probability(sim, params)`` (what the planner knows when it plans) and then executes it,
+recording per row (:data:`COLUMNS`):
+
+- ``p``: the strict success probability; ``param``: the parameter's value (radians, or the target state);
+- ``success``: the strict criterion (:func:`primitives.rewards.success`) and a valid sample;
+- ``made_progress``: ``planner.execute.made_progress``'s criterion (:func:`made_progress`, a copy: primitives may
+  not import planner);
+- ``progress``: the share of the asked effect achieved: push, displacement along the asked direction over
+  ``PUSH_STEP`` (5 cm); spin, the turn in the asked sense over ``|angle|``; roll, 1 when it ended in the asked
+  resting state, else 0. A push or spin that left the object in another resting state has progress 0 (the
+  planner must replan from that state; the cost of the detour is not modelled);
+- ``dx, dy, dyaw``: the SE(2) displacement (push: in the asked direction's frame, ``dx`` along it; otherwise the
+  world frame; metres, radians; ``dyaw`` from the resting state's yaw, 0 when the state changed);
+- ``state_before``, ``state_after``, ``state_asked`` (roll's target, else the start state), ``valid``,
+  ``object`` (an index into the file's ``objects`` names).
+
+The file is a plain ``.npz`` (``np.load(..., allow_pickle=False)`` reads it): the columns, ``objects``, and the
+strings ``skill``, ``objects_spec``, ``command``.
+
+**check**: collects fresh rollouts the same way (on objects never collected on) and reports how well the model
+(:class:`primitives.outcome_model.OutcomeModel`) predicts them: the coverage of its 10-90 % progress interval
+for each rollout's ``p`` (target 0.8), the mean predicted against measured progress, and the accuracy of
+``p_progress`` (Brier score, mean predicted vs measured share that made progress).
+
+Made on the 2-core development machine beside two training jobs (``nice -n 5``, one torch thread), 0.24.0.dev0:
+
+    python -m primitives.training.outcomes collect push --rollouts 600 --objects train+housekeep:training --seed 0 --out primitives/weights/push_outcome.npz
+    python -m primitives.training.outcomes collect spin --rollouts 600 --objects train+housekeep:training --seed 0 --out primitives/weights/spin_outcome.npz
+    python -m primitives.training.outcomes collect roll --rollouts 600 --objects train+housekeep:training --seed 0 --out primitives/weights/roll_outcome.npz
+
+RECORD_PLACEHOLDER
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import shlex
+import sys
+import time
+from collections import OrderedDict
+from collections.abc import Mapping
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from affordplan.errors import AffordplanError, InputError
+from affordplan.geometry import wrap_angle
+from affordplan.log import cli_logging
+from affordplan.objects.model import ObjectModel, load_object, random_object
+from affordplan.sim.simulator import Simulator
+from primitives import params as skill_params
+from primitives.params import PUSH_STEP, SKILLS, SPIN_MAX, SPIN_MIN
+from primitives.skills import Skill, load_skills, skills_sensor
+from primitives.training.env import EnvConfig, _lru, object_groups
+
+# planner.execute's thresholds for "made progress" (copied: primitives may not import planner)
+MIN_PUSH_PROGRESS = 0.01  # metres along the asked direction
+MIN_SPIN_SHARE = 1.0 / 3.0  # of the asked turn, in the asked sense
+
+COLUMNS = {  # name: dtype
+    "p": np.float32, "param": np.float32, "success": bool, "made_progress": bool, "progress": np.float32,
+    "dx": np.float32, "dy": np.float32, "dyaw": np.float32, "state_before": np.int16, "state_after": np.int16,
+    "state_asked": np.int16, "valid": bool, "object": np.int16,
+}
+
+
+def made_progress(obj: ObjectModel, skill: str, params: Mapping, T_before: np.ndarray, T_after: np.ndarray) -> bool:
+    """``planner.execute.made_progress``: a push moved the object at least ``MIN_PUSH_PROGRESS`` along its
+    direction in the same resting state; a spin turned it at least ``MIN_SPIN_SHARE`` of the asked angle, in the
+    asked sense, in the same state; a roll left it in the target state."""
+    s0, x0, y0, yaw0 = obj.planar_pose(T_before)
+    s1, x1, y1, yaw1 = obj.planar_pose(T_after)
+    if skill == "roll":
+        return s1 == params["target"]
+    if s1 != s0:
+        return False
+    if skill == "push":
+        a = params["direction"]
+        return (x1 - x0) * math.cos(a) + (y1 - y0) * math.sin(a) >= MIN_PUSH_PROGRESS
+    turn, asked = float(wrap_angle(yaw1 - yaw0)), params["angle"]
+    return turn * math.copysign(1.0, asked) >= MIN_SPIN_SHARE * abs(asked)
+
+
+def measure(obj: ObjectModel, skill: str, params: Mapping, T_before: np.ndarray, T_after: np.ndarray) -> dict:
+    """What a call did: ``progress`` (share of the asked effect), ``dx, dy, dyaw``, the states and ``made_progress``
+    (module docstring)."""
+    s0, x0, y0, yaw0 = obj.planar_pose(T_before)
+    s1, x1, y1, yaw1 = obj.planar_pose(T_after)
+    dx, dy = x1 - x0, y1 - y0
+    dyaw = float(wrap_angle(yaw1 - yaw0)) if s1 == s0 else 0.0
+    asked = s0
+    if skill == "push":
+        a = params["direction"]
+        dx, dy = dx * math.cos(a) + dy * math.sin(a), -dx * math.sin(a) + dy * math.cos(a)
+        progress = dx / PUSH_STEP if s1 == s0 else 0.0
+    elif skill == "spin":
+        progress = dyaw * math.copysign(1.0, params["angle"]) / abs(params["angle"]) if s1 == s0 else 0.0
+    else:
+        asked = int(params["target"])
+        progress = float(s1 == asked)
+    return dict(progress=progress, dx=dx, dy=dy, dyaw=dyaw, state_before=s0, state_after=s1, state_asked=asked,
+                made_progress=made_progress(obj, skill, params, T_before, T_after))
+
+
+def draw_params(skill: str, rng: np.random.Generator, obj: ObjectModel, state: int) -> dict | None:
+    """A parameter as the planner asks them (module docstring); ``None`` for a roll with no target."""
+    if skill == "push":
+        return {"direction": float(rng.uniform(-math.pi, math.pi))}
+    if skill == "spin":
+        return {"angle": float(rng.choice([-1.0, 1.0]) * rng.uniform(SPIN_MIN, SPIN_MAX))}
+    targets = skill_params.roll_targets(obj, state)
+    return {"target": int(rng.choice(targets))} if targets else None
+
+
+def object_name(key) -> str:
+    return f"{key[0]}/{key[1]}" if isinstance(key, tuple) else str(key)
+
+
+def collect(skill: str, skills: Mapping[str, Skill], rollouts: int, objects: str = "train+housekeep:training",
+            seed: int = 0, n_objects: int = 500, progress: bool = True, sim_cache: int = 32) -> dict:
+    """``rollouts`` rows (skipped starts not counted) of ``skill`` calls, as the columns of :data:`COLUMNS` plus
+    ``objects`` (names) and ``skipped`` (roll starts with no target); see the module docstring."""
+    if skill not in SKILLS:
+        raise InputError(f"unknown skill {skill!r}; expected one of {SKILLS}")
+    cfg = EnvConfig(skill, objects=objects, n_objects=n_objects)
+    groups = object_groups(objects, n_objects)
+    sensor = skills_sensor(dict(skills))
+    rng = np.random.default_rng(seed)
+    models: OrderedDict = OrderedDict()
+    sims: OrderedDict = OrderedDict()
+    rows = {k: [] for k in COLUMNS}
+    names: dict[str, int] = {}
+    skipped = 0
+    bar = tqdm(total=rollouts, desc=f"outcomes {skill}", disable=not progress, unit="rollout", mininterval=2.0)
+    while len(rows["p"]) < rollouts:
+        keys = groups[int(rng.integers(len(groups)))] if len(groups) > 1 else groups[0]
+        key = keys[int(rng.integers(len(keys)))]
+        obj = _lru(models, key, cfg.model_cache,
+                   lambda: random_object(key[1], key[0]) if isinstance(key, tuple) else load_object(key))
+        sim = _lru(sims, key, sim_cache,
+                   lambda: Simulator(obj, pusher="finger", seed=int(rng.integers(2**31)), sensor=sensor),
+                   evict=Simulator.close)
+        states = obj.resting_states
+        probs = np.array([s.probability for s in states])
+        start = int(rng.choice(len(states), p=probs / probs.sum()))
+        (x0, x1), (y0, y1) = cfg.xy_range
+        sim.reset(resting_state=start, xy=(rng.uniform(x0, x1), rng.uniform(y0, y1)), yaw=rng.uniform(-np.pi, np.pi))
+        state = obj.classify(sim.object_pose())
+        params = draw_params(skill, rng, obj, state)
+        if params is None:
+            skipped += 1
+            continue
+        p = skills[skill].success_probability(sim, params)
+        out = skills[skill].execute(sim, params)
+        m = measure(obj, skill, params, out.pose_before, out.pose_after)
+        row = dict(m, p=p, param=next(iter(params.values())), success=bool(out.success), valid=bool(out.valid),
+                   object=names.setdefault(object_name(key), len(names)))
+        for k in COLUMNS:
+            rows[k].append(row[k])
+        bar.update(1)
+    bar.close()
+    for s in sims.values():
+        s.close()
+    data = {k: np.asarray(v, dtype=COLUMNS[k]) for k, v in rows.items()}
+    data["objects"] = np.asarray(list(names), dtype=str)
+    data["skipped"] = np.asarray(skipped)
+    return data
+
+
+def save(path: str, data: Mapping[str, np.ndarray], skill: str, objects: str, command: str) -> None:
+    """Write the rows as a plain compressed ``.npz`` (no pickled objects)."""
+    np.savez_compressed(path, **data, skill=np.asarray(skill), objects_spec=np.asarray(objects),
+                        command=np.asarray(command))
+
+
+def check(model, data: Mapping[str, np.ndarray], lo: float = 0.1, hi: float = 0.9) -> dict:
+    """How well ``model`` (:class:`primitives.outcome_model.OutcomeModel`) predicts the rows ``data``: coverage of
+    its ``lo``-``hi`` progress interval, mean predicted vs measured progress, and ``p_progress``'s accuracy."""
+    p = np.asarray(data["p"], dtype=float)
+    progress = np.asarray(data["progress"], dtype=float)
+    made = np.asarray(data["made_progress"], dtype=bool)
+    qlo, qhi = model.progress_quantiles(p, (lo, hi)).T
+    predicted_mean = model.mean_progress(p)
+    pp = model.p_progress(p)
+    covered = (progress >= qlo - 1e-9) & (progress <= qhi + 1e-9)
+    out = dict(skill=model.skill, rollouts=int(len(p)), interval=[lo, hi], coverage=float(covered.mean()),
+               below=float((progress < qlo - 1e-9).mean()), above=float((progress > qhi + 1e-9).mean()),
+               predicted_mean_progress=float(predicted_mean.mean()), measured_mean_progress=float(progress.mean()),
+               predicted_made_progress=float(pp.mean()), measured_made_progress=float(made.mean()),
+               p_progress_brier=float(np.mean((pp - made) ** 2)),
+               p_progress_accuracy=float(np.mean((pp >= 0.5) == made)),
+               strict_p_mean=float(p.mean()), strict_success=float(np.mean(data["success"])),
+               invalid=int(np.sum(~np.asarray(data["valid"], dtype=bool))))
+    if model.skill == "roll":  # progress is made_progress: report p_progress's calibration in bins
+        bins = np.linspace(0.0, 1.0, 6)
+        which = np.clip(np.digitize(pp, bins) - 1, 0, len(bins) - 2)
+        out["p_progress_bins"] = [dict(range=[float(bins[b]), float(bins[b + 1])], n=int(np.sum(which == b)),
+                                       predicted=float(pp[which == b].mean()), measured=float(made[which == b].mean()))
+                                  for b in range(len(bins) - 1) if np.any(which == b)]
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m primitives.training.outcomes", description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    for name in ("collect", "check"):
+        s = sub.add_parser(name)
+        s.add_argument("skill", choices=SKILLS)
+        s.add_argument("--rollouts", type=int, default=600 if name == "collect" else 150)
+        s.add_argument("--objects", default="train+housekeep:training" if name == "collect" else "housekeep:unseen",
+                       help="EnvConfig object groups joined by + (train, test, housekeep:SPLIT, names)")
+        s.add_argument("--n-objects", type=int, default=500, help="procedural objects per split")
+        s.add_argument("--seed", type=int, default=0 if name == "collect" else 1)
+        s.add_argument("--out", default=None, help="write the rows here (.npz)" + ("" if name == "check" else
+                                                                                  " (required)"))
+        if name == "check":
+            s.add_argument("--model", default=None, help="outcome model .npz (default: the shipped one)")
+            s.add_argument("--json", action="store_true")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    cli_logging()
+    if args.rollouts < 1:
+        parser.error("--rollouts must be a positive integer")
+    if args.command == "collect" and args.out is None:
+        parser.error("collect needs --out")
+    torch.set_num_threads(1)
+    command = "python -m primitives.training.outcomes " + shlex.join(sys.argv[1:] if argv is None else argv)
+    try:
+        model = None
+        if args.command == "check":
+            from primitives.outcome_model import OutcomeModel
+
+            model = OutcomeModel.load(args.skill, args.model)
+        skills = load_skills()
+        t0 = time.perf_counter()
+        data = collect(args.skill, skills, args.rollouts, args.objects, args.seed, args.n_objects,
+                       progress=not getattr(args, "json", False))
+        wall = time.perf_counter() - t0
+        if args.out is not None:
+            save(args.out, data, args.skill, args.objects, command)
+    except AffordplanError as exc:
+        print(f"primitives.training.outcomes: error: {exc}", file=sys.stderr)
+        return 2
+    summary = dict(rows=int(len(data["p"])), skipped=int(data["skipped"]), objects=int(len(data["objects"])),
+                   wall_s=round(wall, 1), success=float(data["success"].mean()),
+                   made_progress=float(data["made_progress"].mean()), mean_progress=float(data["progress"].mean()),
+                   mean_p=float(data["p"].mean()))
+    if model is not None:
+        summary.update(check(model, data), objects_spec=args.objects, seed=args.seed)
+    if getattr(args, "json", False):
+        print(json.dumps(summary, indent=2))
+    else:
+        for k, v in summary.items():
+            print(f"{k:>24s}: {v:.3f}" if isinstance(v, float) else f"{k:>24s}: {v}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,114 @@
+"""The plan bench (affordplan.app.bench.plan), which plans every task through planner.api.plan: solvable tasks,
+seeds and draws, chosen tasks and their logs, the report, household objects, plan-level calibration."""
+
+import numpy as np
+import pytest
+from planner_fakes import ideal_planner
+
+from affordplan.errors import InputError
+
+
+def test_bench_tasks_can_be_solved_in_principle():
+    """Free start, goal free at its asked yaw, goal state reachable by rolls: no task is lost before it starts."""
+    import networkx as nx
+
+    from affordplan.app.bench.plan import make_task
+    from planner.graph import RestingStateGraph
+
+    rng = np.random.default_rng(0)
+    for i in range(12):
+        task, obj = make_task(rng, i)
+        planner = ideal_planner(obj, task.obstacles)
+        s = task.start["resting_state"]
+        assert planner.checkers[s].is_free(*task.start["xy"], task.start["yaw"])
+        g = task.goal.resting_state
+        assert g is not None and 0 <= g < len(obj.resting_states)
+        assert planner.check_goal(task.goal, s) == g  # raises GoalError for a goal in a wall at its yaw
+        assert g == s or nx.has_path(RestingStateGraph(obj, lambda a, b: 1.0).graph, s, g)
+
+
+def test_bench_seeds_draw_their_own_objects_and_cap_the_task_count():
+    from affordplan.app.bench.plan import OBJECTS_PER_SEED, bench_plan, make_task
+
+    _, obj = make_task(np.random.default_rng(3), OBJECTS_PER_SEED * 3 + 7)
+    assert obj.name.startswith(f"test_{OBJECTS_PER_SEED * 3 + 7}_")
+    with pytest.raises(InputError, match="n_tasks"):
+        bench_plan(OBJECTS_PER_SEED + 1, seed=0, progress=False)
+
+
+def test_bench_runs_chosen_tasks_of_the_seed_s_draw_and_logs_their_executions():
+    """``only=[3]`` runs the task a whole run meets fourth (tasks are drawn in order), and the log shows its plan
+    and each executed primitive with the resting states it went between."""
+    from affordplan.app.bench.plan import OBJECTS_PER_SEED, _describe, bench_plan, make_task
+    from affordplan.errors import InputError
+
+    rng = np.random.default_rng(2)
+    task = [make_task(rng, OBJECTS_PER_SEED * 2 + i)[0] for i in range(4)][3]
+    lines: list[str] = []
+    report = bench_plan(50, sim="finger", seed=2, planners=("greedy",), max_primitives=1, progress=False,
+                        only=[3], log=lines.append)
+    (result,) = report.results
+    assert result.task == 3 and result.primitives == 1
+    header, execution = lines
+    assert header.startswith(f"=== seed 2 task 3: test_{OBJECTS_PER_SEED * 2 + 3}_") and _describe(task) in header
+    assert "execution:" in execution and " 0. " in execution and "state " in execution
+    assert report.as_dict()["tasks"][0]["task"] == 3
+    with pytest.raises(InputError, match="task indices"):
+        bench_plan(50, seed=2, progress=False, only=[OBJECTS_PER_SEED])
+
+
+def test_bench_draws_rerun_the_same_tasks_with_other_random_numbers():
+    """``draw=0`` keeps the seeds the bench always used (``seed + task``); each other draw gives every task its own
+    seed, and runs the very same task (object, scene, start, goal)."""
+    from affordplan.app.bench.plan import bench_plan, task_seed
+    from affordplan.errors import InputError
+
+    assert [task_seed(3, i) for i in range(3)] == [3, 4, 5] and task_seed(3, None) == 3
+    seeds = {task_seed(s, i, d) for s in range(3) for i in [None, *range(50)] for d in (1, 2)}
+    assert len(seeds) == 3 * 51 * 2 and not seeds & set(range(100))
+    assert task_seed(3, 7, 1) == task_seed(3, 7, 1)
+    headers = {}
+    for draw in (0, 1):
+        lines: list[str] = []
+        report = bench_plan(50, sim="finger", seed=2, planners=("greedy",), max_primitives=1, progress=False,
+                            only=[3], log=lines.append, draw=draw)
+        assert report.as_dict()["draw"] == draw and report.results[0].task == 3
+        headers[draw] = lines[0]
+    assert headers[0] == headers[1]
+    with pytest.raises(InputError, match="draw"):
+        bench_plan(50, seed=2, progress=False, only=[3], draw=-1)
+
+
+def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
+    from affordplan.app.bench.plan import RARE_GOAL_STATE, BenchReport, TaskResult
+
+    def result(ok, p_goal, missed=""):
+        return TaskResult("affordplan", "open", ok, 0.1, 5, 1, "", p_goal, missed=missed)
+
+    report = BenchReport([result(True, 0.4), result(True, 0.3), result(False, 0.02, "state"), result(True, 0.01),
+                          result(False, RARE_GOAL_STATE, "yaw")])
+    s = report.summary("affordplan")
+    assert s["success"] == pytest.approx(3 / 5)  # rare goals stay in the success rate
+    assert s["rare_goal_states"] == dict(tasks=2, reached=1)
+    assert s["failures"] == {"state": 1, "yaw": 1}
+    assert "rare goal 1/2" in report.report() and "by what they missed: state 1, yaw 1" in report.report()
+
+
+def test_household_tasks_take_the_unseen_meshes_and_mixed_ones_alternate():
+    from affordplan.app.bench.plan import task_object
+    from affordplan.objects import housekeep
+
+    unseen = {f"housekeep/{n}" for n in housekeep.names("unseen")}
+    assert task_object(3, "household").name in unseen
+    assert task_object(3, "mixed").name in unseen and task_object(4, "mixed").name.startswith("test_4_")
+    with pytest.raises(InputError, match="objects"):
+        task_object(0, "kitchen")
+
+
+def test_plan_calibration_scores_predictions_against_outcomes():
+    from affordplan.app.bench.plan import plan_calibration
+
+    cal = plan_calibration([1.0, 0.0, 0.5, float("nan")], [True, False, True, True])
+    assert cal["plans"] == 3 and cal["brier"] == pytest.approx(0.25 / 3)
+    assert cal["reached"] == pytest.approx(2 / 3) and sum(b["plans"] for b in cal["bins"]) == 3
+    assert plan_calibration([float("nan")], [True])["plans"] == 0

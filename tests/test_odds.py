@@ -1,0 +1,155 @@
+"""A plan's odds under closed-loop execution (planner.odds): retried steps within a primitive budget."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from affordplan.errors import InputError
+from planner.odds import Q_FLOOR, mc_odds, plan_odds, primitives_pmf
+from primitives.outcome_model import OutcomeModel
+
+
+def test_certain_steps_take_one_primitive_each():
+    odds = plan_odds([1.0, 1.0, 1.0], budget=10)
+    assert odds.p_success == pytest.approx(1.0)
+    assert odds.expected_primitives == pytest.approx(3.0)
+    assert plan_odds([1.0, 1.0, 1.0], budget=2).p_success == pytest.approx(0.0)
+
+
+def test_one_step_is_a_geometric_distribution():
+    pmf = primitives_pmf([0.4], budget=5)
+    assert pmf[1:] == pytest.approx([0.4 * 0.6 ** (k - 1) for k in range(1, 6)])
+    assert plan_odds([0.4], budget=5).p_success == pytest.approx(1 - 0.6 ** 5)
+
+
+def test_an_empty_plan_has_reached():
+    odds = plan_odds([], budget=0)
+    assert odds.p_success == 1.0 and odds.expected_primitives == 0.0
+
+
+def test_a_large_budget_gives_the_mean_of_retries():
+    odds = plan_odds([0.5, 0.25], budget=400)
+    assert odds.p_success == pytest.approx(1.0, abs=1e-9)
+    assert odds.expected_primitives == pytest.approx(1 / 0.5 + 1 / 0.25, rel=1e-6)
+
+
+def test_matches_a_simulation_of_retried_steps():
+    q, budget = [0.3, 0.6, 0.45, 0.8], 9
+    rng = np.random.default_rng(0)
+    totals = sum(rng.geometric(p, size=200_000) for p in q)
+    assert plan_odds(q, budget).p_success == pytest.approx(np.mean(totals <= budget), abs=0.005)
+
+
+@given(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=8), st.integers(1, 80), st.floats(0.0, 0.5))
+def test_odds_fall_when_a_step_gets_less_likely(q, budget, drop):
+    worse = list(q)
+    worse[0] = max(0.0, worse[0] - drop)
+    assert plan_odds(worse, budget).p_success <= plan_odds(q, budget).p_success + 1e-12
+    assert 0.0 <= plan_odds(q, budget).p_success <= 1.0
+
+
+def test_a_step_rated_zero_is_floored_not_impossible():
+    assert plan_odds([0.0], budget=60).p_success == pytest.approx(1 - (1 - Q_FLOOR) ** 60)
+
+
+@pytest.mark.parametrize("bad", [[math.nan], [1.5], [-0.1]])
+def test_bad_probabilities_are_refused(bad):
+    with pytest.raises(InputError):
+        plan_odds(bad)
+
+
+# ------------------------------------------------------------------ mc_odds: Monte Carlo through outcome models
+class Constant:
+    """An outcome model whose every call achieves ``value`` of the asked effect."""
+
+    def __init__(self, value: float):
+        self.value = value
+
+    def sample_progress(self, p_strict, rng, n):
+        return np.full(n, self.value)
+
+
+def _model(skill: str, scale: float = 1.0, seed: int = 0) -> OutcomeModel:
+    """Progress ~ scale * U(0, 2 p + 0.2): likelier calls achieve more."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(0.0, 1.0, 400)
+    return OutcomeModel(skill, p, scale * rng.uniform(0.0, 2 * p + 0.2))
+
+
+def test_mc_odds_is_deterministic_per_seed():
+    models = {"push": _model("push"), "roll": _model("roll"), "spin": _model("spin")}
+    steps = [("push", 0.3), ("push", 0.1), ("roll", 0.6), ("spin", 0.5), ("push", 0.2)]
+    a, b = mc_odds(steps, models, budget=30, seed=4), mc_odds(steps, models, budget=30, seed=4)
+    assert a == b
+    other = mc_odds(steps, models, budget=30, seed=5)
+    assert other.p_success == pytest.approx(a.p_success, abs=0.06)
+    assert other.expected_primitives == pytest.approx(a.expected_primitives, rel=0.1)
+
+
+@pytest.mark.parametrize("n_steps", [1, 3, 8])
+def test_calls_that_always_achieve_their_step_take_one_primitive_each(n_steps):
+    odds = mc_odds([("push", 0.05)] * n_steps, {"push": Constant(1.0)}, budget=20, n=100)
+    assert odds.p_success == 1.0 and odds.expected_primitives == n_steps
+
+
+def test_odds_fall_when_progress_halves():
+    steps = [("push", 0.05)] * 4
+    assert mc_odds(steps, {"push": Constant(0.5)}, budget=8).expected_primitives == 8
+    assert mc_odds(steps, {"push": Constant(0.5)}, budget=7).p_success == 0.0
+    steps = [("push", 0.5)] * 4  # about 7 primitives at full progress, 14 at half
+    full, half = _model("push"), _model("push", scale=0.5)
+    for budget in (6, 10, 20):
+        assert mc_odds(steps, {"push": half}, budget).p_success < mc_odds(steps, {"push": full}, budget).p_success
+    assert (mc_odds(steps, {"push": half}, 200).expected_primitives
+            == pytest.approx(2 * mc_odds(steps, {"push": full}, 200).expected_primitives, rel=0.15))
+
+
+def test_the_budget_caps():
+    steps = [("push", 0.5)] * 5
+    odds = mc_odds(steps, {"push": Constant(1.0)}, budget=3)
+    assert odds.p_success == 0.0 and odds.expected_primitives == 3 and odds.budget == 3
+    assert mc_odds(steps, {"push": Constant(0.0)}, budget=40).expected_primitives == 40
+    assert mc_odds(steps, {"push": Constant(1.0)}, budget=0).expected_primitives == 0
+
+
+def test_surplus_carries_over_within_a_stretch_of_one_skill_only():
+    models = {"push": Constant(1.4), "roll": Constant(1.0), "spin": Constant(1.4)}
+    # five pushes: 1.4, 2.8, 4.2, 5.6 -> four primitives
+    assert mc_odds([("push", 0.5)] * 5, models, budget=20).expected_primitives == 4
+    # a roll between two pairs of pushes: 2 + 1 + 2 primitives (no carry across the roll)
+    steps = [("push", 0.5)] * 2 + [("roll", 0.5)] + [("push", 0.5)] * 2
+    assert mc_odds(steps, models, budget=20).expected_primitives == 5
+    # a spin after a push starts from nothing
+    assert mc_odds([("push", 0.5), ("spin", 0.5)], models, budget=20).expected_primitives == 2
+
+
+def test_negative_progress_counts_zero_and_a_roll_needs_its_state():
+    assert mc_odds([("push", 0.5)], {"push": Constant(-3.0)}, budget=10).p_success == 0.0
+    roll_misses = {"roll": Constant(0.9)}
+    assert mc_odds([("roll", 0.9)], roll_misses, budget=10).p_success == 0.0
+    assert mc_odds([("roll", 0.9), ("roll", 0.9)], {"roll": Constant(2.0)}, 10).expected_primitives == 2
+
+
+def test_mc_odds_follows_the_geometric_model_for_all_or_nothing_calls():
+    q = [0.3, 0.6, 0.45]
+    models = {s: OutcomeModel(s, np.full(1000, p), (np.arange(1000) < 1000 * p).astype(float), k=1000)
+              for s, p in zip(("push", "spin", "roll"), q)}
+    steps = [("push", 0.3), ("spin", 0.6), ("roll", 0.45)]
+    odds = mc_odds(steps, models, budget=9, n=20_000)
+    assert odds.p_success == pytest.approx(plan_odds(q, 9).p_success, abs=0.015)
+
+
+def test_an_empty_plan_has_reached_by_mc():
+    odds = mc_odds([], {}, budget=5)
+    assert odds.p_success == 1.0 and odds.expected_primitives == 0.0
+
+
+@pytest.mark.parametrize("steps", [[("push", 1.5)], [("push", math.nan)], [("slide", 0.5)], [("push",)]])
+def test_mc_odds_refuses_bad_steps(steps):
+    with pytest.raises(InputError):
+        mc_odds(steps, {"push": Constant(1.0)}, budget=10)
