@@ -163,3 +163,39 @@ def test_a_primitive_refused_before_any_physics_ends_the_execution():
     assert _terminal(pressed) is None
     assert "off_table" in _terminal(carried)
     assert _terminal(SimpleNamespace(valid=True, invalid_reason=None, n_steps=0)) is None
+
+
+def test_execution_does_not_mutate_the_plans_planner():
+    """Failures are remembered in a fork (Planner.fork): the plan's planner, its failure memory and its roll graph
+    are as they were, and planning again from the start gives the same plan."""
+    cube = ap.load_object("cube")
+    direct = skill_params.roll_targets(cube, 0)[0]
+    planner = ideal_planner(cube, fail_roll=(0, direct))
+    goal = ap.Goal(xy=(0.55, 0.05), resting_state=direct)
+    T0 = cube.resting_states[0].pose((0.5, 0.0), 0.0)
+    plan = planner.plan(T0, goal)
+    before = [(s.skill, s.params) for s in plan.steps]
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=20)
+    assert ex.success and ex.replans == 2  # the roll failed twice in the execution's memory
+    assert not planner.failures and not planner.failed_roll_spots
+    assert planner.graph.probability(0, direct) == pytest.approx(0.8)
+    assert [(s.skill, s.params) for s in planner.plan(T0, goal).steps] == before
+    # a memory passed in is the one that learns
+    memory = planner.fork()
+    sim.set_object_pose(plan.start_pose, settle=False)
+    execute_plan(plan, sim=sim, max_primitives=20, memory=memory)
+    assert memory.failures and memory.graph.probability(0, direct) < 0.8 and not planner.failures
+
+
+def test_a_plans_p_success_falls_when_a_skill_is_forced_to_fail():
+    cube = ap.load_object("cube")
+    goal = ap.Goal(xy=(0.62, 0.08))
+    T0 = cube.resting_states[0].pose((0.45, -0.05), 0.0)
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    sure = Planner(cube, predictor=StubPredictor(skills, p=0.9), seed=0).plan(T0, goal)
+    failing = Planner(cube, predictor=StubPredictor(skills, p=0.05), seed=0).plan(T0, goal)
+    assert [s.skill for s in sure.steps] == [s.skill for s in failing.steps]
+    assert sure.p_success > 0.99 and failing.p_success < sure.p_success - 0.3
+    assert failing.expected_primitives > sure.expected_primitives

@@ -325,3 +325,25 @@ def test_a_goal_free_only_in_a_narrow_band_of_yaws_is_accepted_and_reached():
     assert checker.is_free(x, y, yaw)  # the path ends at the goal, at one of the few yaws that fit
     ex = execute_plan(plan, sim=ap.Simulator(obj, obstacles=blocks, pusher="finger", seed=0), max_primitives=30)
     assert ex.success
+
+
+def test_a_partly_blocked_goal_region_is_planned_to_its_free_part():
+    """A goal whose exact point lies a few mm inside a block's clearance is met in the free part of its tolerance
+    disc (the plan aims there and reaches the goal); a goal whose whole region is blocked is refused."""
+    cube = ap.load_object("cube")
+    block = ap.Box(center=(0.6, 0.1), size=(0.06, 0.06, 0.05))
+    planner = ideal_planner(cube, [block])
+    T0 = cube.resting_states[0].pose((0.45, -0.1), 0.0)
+    free_x = max(x for x in np.arange(0.45, 0.6, 0.001) if planner.checkers[0].is_free(x, 0.1, 0.0))
+    goal = ap.Goal(xy=(free_x + 0.006, 0.1), yaw=0.0)
+    assert not planner.checkers[0].is_free(*goal.xy, 0.0)
+    plan = planner.plan(T0, goal)
+    assert plan.goal == goal and plan.aim is not None and plan.aim.xy != goal.xy
+    assert planner.checkers[0].is_free(*plan.aim.xy, plan.aim.yaw)
+    assert math.dist(plan.aim.xy, goal.xy) <= 0.6 * goal.xy_tol
+    sim = ap.Simulator(cube, obstacles=[block], seed=0)
+    sim.set_object_pose(plan.start_pose, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=20)
+    assert ex.success and goal.reached(cube, ex.final_pose)
+    with pytest.raises(GoalError, match="no free placement"):
+        planner.plan(T0, ap.Goal(xy=(0.6, 0.1), yaw=0.0))
