@@ -35,3 +35,21 @@ def mug() -> ap.ObjectModel:
 @pytest.fixture(scope="session")
 def lunch_box() -> ap.ObjectModel:
     return ap.load_object("lunch_box")
+
+
+@pytest.fixture(scope="module")
+def ray_instance():
+    """One local Ray instance shared by a module's tests (the trainer then leaves it running); skipped without Ray.
+    Ray's usage statistics stay off: nothing is reported over the network."""
+    ray = pytest.importorskip("ray")
+    quiet = pytest.MonkeyPatch()
+    quiet.setenv("RAY_USAGE_STATS_ENABLED", "0")
+    started = not ray.is_initialized()
+    if started:
+        ray.init(num_cpus=2, include_dashboard=False, object_store_memory=256 * 2**20)
+    try:
+        yield ray
+    finally:
+        if started:
+            ray.shutdown()
+        quiet.undo()

@@ -1,4 +1,6 @@
-"""The Ray rollout backend: the CLI run writes a checkpoint, weights reach the actors, resume works.
+"""Training on the Ray rollout backend: the CLI run writes a checkpoint, a run learns, syncs and resumes, bad backend
+combinations are refused. (Weights reaching the workers: tests/test_rollouts.py; the backend comparison's statistics:
+tests/test_compare_backends.py; the shared Ray instance: tests/conftest.py.)
 
 Runs on a local Ray instance with 2 CPUs and no dashboard (no network needed). Ray is an optional
 dependency; the file is skipped where it is not installed.
@@ -15,11 +17,7 @@ import pytest
 import torch
 
 from primitives import weights_file
-from primitives.networks import HybridActorCritic
-from primitives.research.compare_backends import Proportions
 from primitives.training import checkpoint as ckpt
-from primitives.training.env import EnvConfig
-from primitives.training.rollouts import Exploration, LocalWorkers, RayWorkers, worker_seed
 from primitives.training.train import TrainConfig, main, train
 
 ray = pytest.importorskip("ray")
@@ -45,65 +43,6 @@ def test_cli_ray_run_writes_checkpoint_and_policy(tmp_path):
     assert all(torch.equal(saved["model"][k], v) for k, v in policy.items())
     config = json.loads((tmp_path / "config.json").read_text())
     assert config["backend"] == "ray" and config["workers"] == 1 and config["ray_address"] is None
-
-
-@pytest.fixture(scope="module")
-def ray_instance():
-    """One local Ray instance shared by the tests below (the trainer then leaves it running)."""
-    started = not ray.is_initialized()
-    if started:
-        ray.init(num_cpus=2, include_dashboard=False, object_store_memory=256 * 2**20)
-    yield ray
-    if started:
-        ray.shutdown()
-
-
-def _saturated_policy(sign: float) -> dict:
-    """Weights whose actor map is ``sign * tanh(8) ~ sign`` for every point and every cloud."""
-    torch.manual_seed(0)
-    model = HybridActorCritic()
-    last = model.actor[-1]
-    with torch.no_grad():
-        last.weight.zero_()
-        last.bias.fill_(8.0 * sign)
-    return model.state_dict()
-
-
-def _poll(source, n: int) -> list:
-    got = []
-    for _ in range(200):
-        got += source.poll(timeout=1.0)
-        if len(got) >= n:
-            return got
-    raise AssertionError(f"only {len(got)} of {n} transitions arrived")
-
-
-@pytest.mark.parametrize("backend", ["ray", "local"])
-def test_pushed_weights_reach_the_workers(backend, request):
-    """Workers start with a policy that moves along -1 and, after a push, act with one that moves along +1."""
-    env_cfg = EnvConfig("push", objects=("cube",), n_points=32)
-    explore = Exploration(motion_noise=0.0)  # the motion is the actor's, exactly
-    seeds = [worker_seed(0, 0, 0)]
-    if backend == "ray":
-        request.getfixturevalue("ray_instance")
-    source = (RayWorkers(env_cfg, explore, seeds, _saturated_policy(-1.0), batch=4, max_inflight=2)
-              if backend == "ray" else LocalWorkers(env_cfg, explore, seeds, _saturated_policy(-1.0)))
-    try:
-        before = _poll(source, 4)
-        assert all(np.all(t[2] < -0.99) for t in before)
-        assert all(t[0].shape == (32, 9) and t[0].dtype == np.float16 for t in before)
-        source.push_weights(_saturated_policy(+1.0))
-        after = []
-        for _ in range(10):  # what was requested before the push still comes back with the old weights
-            after += _poll(source, 1)
-            if np.all(after[-1][2] > 0.99):
-                break
-        assert np.all(after[-1][2] > 0.99), "the pushed weights never reached the worker"
-        assert source.worker_rss_mb() > 0.0
-    finally:
-        source.close()
-    if backend == "ray":
-        assert ray.is_initialized()  # a source that did not start Ray leaves it running
 
 
 @pytest.mark.slow
@@ -134,13 +73,3 @@ def test_cli_rejects_bad_backend_combinations_and_a_missing_ray(tmp_path, monkey
     assert not (tmp_path / "checkpoint.pt").exists()
 
 
-def test_two_proportion_tests_agree_with_the_chi_square_test():
-    from scipy.stats import chi2_contingency
-
-    table = Proportions(successes=(260, 239), trials=(600, 600))
-    z, p = table.z_test()
-    chi2, p_chi2, _, _ = chi2_contingency([[260, 340], [239, 361]], correction=False)
-    assert z > 0 and z**2 == pytest.approx(chi2) and p == pytest.approx(p_chi2)
-    assert Proportions((239, 260), (600, 600)).z_test()[0] == pytest.approx(-z)
-    assert 0.0 < table.fisher() <= 1.0
-    assert Proportions((0, 0), (50, 70)).z_test() == (0.0, 1.0)  # nothing to tell apart

@@ -1,5 +1,5 @@
-"""Skills with the arm (a contact it cannot reach is masked out and the policy's next best one is tried), and skills
-loaded from a folder of weights."""
+"""Skills (primitives.skills): acting and judging with given weights, the shipped weights offline, the arm (a contact
+it cannot reach is masked out and the policy's next best one is tried), and skills loaded from a folder of weights."""
 
 from __future__ import annotations
 
@@ -8,11 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import torch
 
 import affordplan as ap
 from affordplan.errors import InputError, ReachabilityError
-from primitives import load_skill
+from primitives import load_skill, rewards, weights_file
 from primitives import skills as skills_module
+from primitives.networks import HybridActorCritic
 
 
 class _ReachLimited(ap.Simulator):
@@ -149,3 +151,38 @@ def test_a_weights_folder_is_refused_without_a_success_model_or_beside_other_fil
         load_skill("push", weights_dir=tmp_path / "missing")
     with pytest.raises(InputError, match="not both"):
         load_skill("push", weights=tmp_path / "push.pt", weights_dir=tmp_path)
+
+
+def test_skill_acts_and_judges_with_given_weights(tmp_path):
+    torch.manual_seed(0)
+    weights_file.save(tmp_path / "w.pt", dict(model=HybridActorCritic().state_dict()),
+                      weights_file.make_meta("push", "policy"))
+    skill = load_skill("push", weights=tmp_path / "w.pt")
+    sim = ap.Simulator(ap.load_object("cube"))
+    sim.reset()
+    contact, motion = skill.act(sim)
+    assert contact.shape == (3,) and np.all(np.abs(motion) <= 1.0)
+    out = skill.execute(sim)
+    assert out.success == (out.valid and rewards_push_success(out))
+    contact_dir, _ = skill.act(sim, params={"direction": 0.0})  # the goal flow changes the input
+    assert contact_dir.shape == (3,)
+    for bad in ({"direction": float("nan")}, {"angle": 0.3}, {"direction": "east"}, [0.0]):
+        with pytest.raises(InputError):
+            skill.act(sim, params=bad)
+    with pytest.raises(InputError):
+        load_skill("jump")
+
+
+def rewards_push_success(out) -> bool:
+    return rewards.push_success(out.pose_before, out.pose_after)
+
+
+@pytest.mark.parametrize("name", ["push", "roll", "spin"])
+def test_shipped_weights_load_offline_and_act(name):
+    skill = load_skill(name)  # primitives/weights/NAME.pt, package data
+    sim = ap.Simulator(ap.load_object("cube"), seed=3)
+    sim.reset()
+    contact, motion = skill.act(sim)
+    assert np.all(np.isfinite(contact)) and np.all(np.abs(motion) <= 1.0)
+    again = load_skill(name).act(ap.Simulator(ap.load_object("cube"), seed=3))
+    assert np.array_equal(again[0], contact) and np.array_equal(again[1], motion)  # deterministic

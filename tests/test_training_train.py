@@ -1,4 +1,5 @@
-"""Training machinery: networks, replay, checkpoints, a tiny run that learns, deterministic evaluation."""
+"""Training (primitives.training.train): checkpoints that resume, a tiny run that learns, bf16 updates, settings
+refused before anything runs, and the command line's errors (a damaged checkpoint, bad settings)."""
 
 from __future__ import annotations
 
@@ -11,111 +12,13 @@ import pytest
 import torch
 
 from primitives import weights_file
-from primitives.networks import HybridActorCritic, choose_contact
+from primitives.networks import HybridActorCritic
 from primitives.training import checkpoint as ckpt
+from primitives.training import train as train_mod
 from primitives.training.env import EnvConfig, PrimitiveEnv
-from primitives.training.evaluate import evaluate, greedy_action, load_policy
+from primitives.training.evaluate import greedy_action, load_policy
 from primitives.training.replay import ReplayBuffer
 from primitives.training.train import TrainConfig, bf16_is_fast, train, update
-
-
-def test_maps_are_per_point_and_permutation_equivariant():
-    torch.manual_seed(0)
-    model = HybridActorCritic().eval()
-    obs = torch.randn(2, 64, 9)
-    actions, q = model.maps(obs)
-    assert actions.shape == (2, 64, 3) and q.shape == (2, 64)
-    assert actions.abs().max() <= 1.0
-    perm = torch.randperm(64)
-    actions_p, q_p = model.maps(obs[:, perm])
-    assert torch.allclose(q_p, q[:, perm], atol=1e-5) and torch.allclose(actions_p, actions[:, perm], atol=1e-5)
-
-
-def test_contact_choice_greedy_and_exploring():
-    q = torch.tensor([[0.0, 5.0, -1.0]])
-    assert int(choose_contact(q, 0.1, 0.1, None, greedy=True)[0]) == 1
-    gen = torch.Generator().manual_seed(0)
-    picks = [int(choose_contact(q, 0.1, 0.3, gen, greedy=False)[0]) for _ in range(400)]
-    assert 0.7 < np.mean(np.array(picks) == 1) < 0.9  # 1 - eps + eps/3 = 0.8
-
-
-def test_replay_memory_is_fixed_and_ring_overwrites():
-    buf = ReplayBuffer(capacity=10, n_points=8)
-    before = buf.nbytes
-    for i in range(25):
-        buf.add(np.full((8, 9), i, dtype=np.float32), i % 8, np.zeros(3), float(i), i % 2 == 0)
-    assert buf.nbytes == before and buf.size == 10
-    assert set(buf.reward.astype(int)) == set(range(15, 25))
-    restored = ReplayBuffer(capacity=10, n_points=8)
-    restored.load_state(buf.state())
-    assert np.array_equal(restored.obs, buf.obs) and restored.cursor == buf.cursor
-
-
-def test_env_step_returns_the_seed_reward():
-    env = PrimitiveEnv(EnvConfig("push", objects=("cube",), n_points=64), seed=0)
-    obs = env.reset()
-    assert obs.shape == (64, 9) and obs.dtype == np.float32
-    assert np.allclose(obs[:, :2].mean(axis=0), 0.0, atol=1e-5)
-    res = env.step(0, np.array([1.0, 0.0, 0.0]))
-    from primitives import rewards
-
-    assert res.reward == pytest.approx(-rewards.push_loss(res.outcome.pose_before, res.outcome.pose_after))
-
-
-def test_env_builds_each_object_model_once_and_the_cache_changes_no_episode():
-    """Three objects drawn in turn through one cached simulator: with the model cache each object's model
-    (resting states, surface samples) is built once and reused when its simulator is rebuilt; without it,
-    rebuilt. The clouds and rewards are the same either way."""
-    def run(model_cache):
-        env = PrimitiveEnv(EnvConfig("spin", objects=("cube", "tape", "pill_bottle"), n_points=64,
-                                     episodes_per_object=1, sim_cache=1, model_cache=model_cache), seed=4)
-        seen, rng = [], np.random.default_rng(0)
-        for key in ("cube", "tape", "cube", "pill_bottle", "tape", "cube"):
-            obs = env.reset(object_key=key)
-            res = env.step(int(rng.integers(64)), rng.uniform(-1, 1, size=3))
-            seen.append((key, env.sim.obj, obs, res.reward))
-        env.close()
-        return seen
-
-    cached, uncached = run(512), run(0)
-    models = {}
-    for key, model, _, _ in cached:
-        assert models.setdefault(key, model) is model  # one model per object, reused
-    assert len({id(model) for key, model, _, _ in uncached if key == "cube"}) == 3  # rebuilt each draw (held)
-    for (_, _, obs_c, r_c), (_, _, obs_u, r_u) in zip(cached, uncached):
-        assert np.array_equal(obs_c, obs_u) and r_c == r_u
-
-
-@pytest.mark.parametrize("field, value, words", [
-    ("primitive", "jump", "unknown primitive 'jump'"),
-    ("sim_cache", 0, "EnvConfig.sim_cache must be a whole number >= 1, got 0"),  # would close the sim in use
-    ("model_cache", -1, "EnvConfig.model_cache must be a whole number >= 0, got -1"),
-    ("n_points", 8.0, "EnvConfig.n_points must be a whole number >= 16, got 8.0"),
-    ("episodes_per_object", 0, "EnvConfig.episodes_per_object must be a whole number >= 1"),
-    ("p_params", float("nan"), "EnvConfig.p_params is a probability in [0, 1], got nan"),
-])
-def test_env_refuses_a_config_it_cannot_run(field, value, words):
-    from affordplan.errors import InputError
-
-    with pytest.raises(InputError) as info:
-        PrimitiveEnv(replace(EnvConfig("push", objects=("cube",)), **{field: value}))
-    assert words in str(info.value)
-    env = PrimitiveEnv(EnvConfig("push", objects=("cube",), n_points=16, sim_cache=1, model_cache=0))
-    assert env.reset().shape == (16, 9)  # the least values run
-
-
-def test_corrupt_checkpoint_gives_a_clear_error(tmp_path):
-    path = tmp_path / "checkpoint.pt"
-    path.write_bytes(b"not a checkpoint at all")
-    with pytest.raises(ckpt.CheckpointError, match="damaged"):
-        ckpt.load(path)
-    ckpt.save(path, {"model": {"w": torch.ones(3)}})
-    data = path.read_bytes()
-    path.write_bytes(data[: len(data) // 2])  # truncated
-    with pytest.raises(ckpt.CheckpointError):
-        ckpt.load(path)
-    with pytest.raises(ckpt.CheckpointError, match="no checkpoint"):
-        ckpt.load(tmp_path / "missing.pt")
 
 
 def _cube_config(out, steps: int) -> TrainConfig:
@@ -148,8 +51,6 @@ def test_resume_lets_go_of_the_loaded_checkpoint(tmp_path, monkeypatch):
     one-hour run)."""
     import gc
     import weakref
-
-    import primitives.training.train as train_mod
 
     train(_cube_config(tmp_path, 120), progress=False)
     held, load = [], ckpt.load
@@ -233,62 +134,6 @@ def test_a_bf16_update_is_the_float32_update_up_to_rounding():
         assert float(torch.nn.functional.cosine_similarity(a, b, dim=0)) > 0.9, part
 
 
-def test_evaluation_is_deterministic():
-    torch.manual_seed(1)
-    model = HybridActorCritic().eval()
-    a = evaluate(model, "spin", ("cube",), trials=4, seed=5, progress=False)
-    b = evaluate(model, "spin", ("cube",), trials=4, seed=5, progress=False)
-    assert a.per_object == b.per_object
-    env = PrimitiveEnv(EnvConfig("spin", objects=("cube",), n_points=64), seed=0)
-    obs = env.reset()
-    first, second = greedy_action(model, obs), greedy_action(model, obs)
-    assert first[0] == second[0] and np.array_equal(first[1], second[1])
-
-
-def test_skill_acts_and_judges_with_given_weights(tmp_path):
-    import affordplan as ap
-    from affordplan.errors import InputError
-    from primitives import load_skill
-
-    torch.manual_seed(0)
-    weights_file.save(tmp_path / "w.pt", dict(model=HybridActorCritic().state_dict()),
-                      weights_file.make_meta("push", "policy"))
-    skill = load_skill("push", weights=tmp_path / "w.pt")
-    sim = ap.Simulator(ap.load_object("cube"))
-    sim.reset()
-    contact, motion = skill.act(sim)
-    assert contact.shape == (3,) and np.all(np.abs(motion) <= 1.0)
-    out = skill.execute(sim)
-    assert out.success == (out.valid and rewards_push_success(out))
-    contact_dir, _ = skill.act(sim, params={"direction": 0.0})  # the goal flow changes the input
-    assert contact_dir.shape == (3,)
-    for bad in ({"direction": float("nan")}, {"angle": 0.3}, {"direction": "east"}, [0.0]):
-        with pytest.raises(InputError):
-            skill.act(sim, params=bad)
-    with pytest.raises(InputError):
-        load_skill("jump")
-
-
-def rewards_push_success(out) -> bool:
-    from primitives import rewards
-
-    return rewards.push_success(out.pose_before, out.pose_after)
-
-
-@pytest.mark.parametrize("name", ["push", "roll", "spin"])
-def test_shipped_weights_load_offline_and_act(name):
-    import affordplan as ap
-    from primitives import load_skill
-
-    skill = load_skill(name)  # primitives/weights/NAME.pt, package data
-    sim = ap.Simulator(ap.load_object("cube"), seed=3)
-    sim.reset()
-    contact, motion = skill.act(sim)
-    assert np.all(np.isfinite(contact)) and np.all(np.abs(motion) <= 1.0)
-    again = load_skill(name).act(ap.Simulator(ap.load_object("cube"), seed=3))
-    assert np.array_equal(again[0], contact) and np.array_equal(again[1], motion)  # deterministic
-
-
 @pytest.mark.parametrize("field, value, words", [
     ("steps", 0, "--steps must be a whole number >= 1"),
     ("steps", 10.5, "--steps must be a whole number"),
@@ -344,3 +189,22 @@ def test_resume_without_a_checkpoint_says_it_starts_a_new_run(tmp_path, caplog):
     assert summary["steps"] == 2 and (tmp_path / "checkpoint.pt").exists()
     assert f"no checkpoint in {tmp_path} yet (the run stopped before its first): starting it again from step 0" \
         in caplog.messages
+
+
+def _tiny_argv(out) -> list[str]:
+    return ["push", "--steps", "20", "--workers", "0", "--out", str(out), "--n-points", "32", "--replay-size", "64",
+            "--learning-starts", "8", "--resume"]
+
+
+@pytest.mark.parametrize("damage", ["truncated", "corrupt"])
+def test_resume_from_a_damaged_checkpoint_is_a_clear_error(tmp_path, capsys, damage):
+    path = tmp_path / "checkpoint.pt"
+    ckpt.save(path, {"model": {"w": torch.ones(1000)}, "state": {"global_step": 3}})
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 3] if damage == "truncated" else b"\x00garbage" + data[8:])
+    assert train_mod.main(_tiny_argv(tmp_path)) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("python -m primitives.train: error: checkpoint ") and "damaged or truncated" in err
+    assert str(path) in err and "Traceback" not in err and len(err.splitlines()) == 1
+    with pytest.raises(ckpt.CheckpointError):
+        train_mod.train(train_mod.TrainConfig(out=str(tmp_path), workers=0), resume=True, progress=False)
