@@ -48,7 +48,7 @@ from planner import chain
 from planner.footprint import footprint, inflate, place
 from planner.graph import RestingStateGraph
 from planner.motion import FootprintChecker, plan_path
-from planner.odds import DEFAULT_BUDGET, Odds, plan_odds
+from planner.odds import DEFAULT_BUDGET, Odds, mc_odds, plan_odds
 from planner.predict import Predictor, expected_pose, state_pose
 from primitives.params import PARAMS_TYPES, SkillName, SkillParams, as_params
 
@@ -239,6 +239,15 @@ class Planner:
         other.graph.graph = self.graph.graph.copy()
         return other
 
+    def odds(self, steps: Sequence[Step], budget: int) -> Odds:
+        """The odds of ``steps`` within ``budget`` primitives under closed-loop execution: by Monte Carlo through the
+        skills' outcome models where the predictor has them (:func:`planner.odds.mc_odds`, seeded by the planner's
+        seed), else each step retried with its strict probability (:func:`planner.odds.plan_odds`)."""
+        outcomes = getattr(self.predictor, "outcomes", None)
+        if outcomes and all(s.skill in outcomes for s in steps):
+            return mc_odds([(s.skill, s.p_success) for s in steps], outcomes, budget, seed=self.seed)
+        return plan_odds([s.p_success for s in steps], budget)
+
     # ------------------------------------------------------------------ queries
     def _roll_probability(self, i: int, j: int) -> float:
         x, y = self.workspace.center
@@ -373,7 +382,7 @@ class Planner:
             raise error
         _, steps, p, paths = best
         self._calls += 1
-        odds = plan_odds([s.p_success for s in steps], self.budget)
+        odds = self.odds(steps, self.budget)
         return Plan(steps=steps, p_success=odds.p_success, planning_time=time.perf_counter() - t0, route=route,
                     paths=paths, expected_primitives=odds.expected_primitives, p_steps=p,
                     goal=asked, start_pose=np.array(T_start), planner=self, aim=goal)
@@ -720,7 +729,8 @@ class Plan:
     Attributes:
         steps: the calls, in order.
         p_success: predicted probability that closed-loop execution reaches the goal within the planner's
-            primitive budget (``Planner.budget``, 60): each step retried until it succeeds (:mod:`planner.odds`).
+            primitive budget (``Planner.budget``, 60), by Monte Carlo through the skills' outcome models
+            (:meth:`Planner.odds`, :mod:`planner.odds`).
         planning_time: seconds.
         route: resting states visited.
         paths: ``(resting state, (m, 3) SE(2) path)`` per segment.
@@ -753,9 +763,9 @@ class Plan:
     def odds(self, budget: int) -> Odds:
         """The plan's odds within ``budget`` primitives (:func:`planner.odds.plan_odds`; ``p_success`` is them
         within the planner's budget)."""
-        if self.kind == "greedy":
+        if self.kind == "greedy" or self.planner is None:
             return Odds(float("nan"), float("nan"), int(budget))
-        return plan_odds([s.p_success for s in self.steps], budget)
+        return self.planner.odds(self.steps, budget)
 
     def execute(self, sim: Literal["arm", "finger"] | Simulator = "arm", max_primitives: int = 60,
                 render: bool | str | None = None, seed: int = 0) -> Execution:

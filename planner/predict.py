@@ -24,6 +24,7 @@ from affordplan.sim.sensor import CameraSensor, surface_cloud
 from affordplan.world import Box
 from primitives import params as skill_params
 from primitives.observation import observe_cloud
+from primitives.outcome_model import OutcomeModel
 from primitives.params import SKILLS
 from primitives.skills import Skill, load_skills, skills_sensor
 
@@ -71,6 +72,11 @@ class Predictor:
         self.obj = obj
         self.skills = skills or load_skills(weights_dir)
         self.sensor = skills_sensor(self.skills)
+        # What the shipped skills' calls achieve (primitives.outcome_model), for the plans' odds; None for skills
+        # given here or loaded from a weights folder, which the shipped outcome models do not describe
+        self.outcomes: dict[str, OutcomeModel] | None = None
+        if skills is None and weights_dir is None:
+            self.outcomes = {name: OutcomeModel.load(name) for name in SKILLS}
         self.obstacles = tuple(obstacles)
         self._samples, self._normals = obj.surface_samples()
         self._seed = seed

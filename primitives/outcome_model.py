@@ -86,6 +86,8 @@ class OutcomeModel:
         if not path.is_file():
             raise WeightsError(f"no {skill} outcome model at {str(path)!r} "
                                f"(python -m primitives.training.outcomes collect {skill} ... --out FILE)")
+        if not zipfile.is_zipfile(path):
+            raise WeightsError(f"{path} is not an outcome model: not an .npz file (damaged or another kind of file)")
         try:
             with np.load(path, allow_pickle=False) as f:
                 missing = [c for c in REQUIRED if c not in f.files]

@@ -153,3 +153,16 @@ def test_an_empty_plan_has_reached_by_mc():
 def test_mc_odds_refuses_bad_steps(steps):
     with pytest.raises(InputError):
         mc_odds(steps, {"push": Constant(1.0)}, budget=10)
+
+
+def test_mc_odds_is_quick_enough_to_rate_every_plan():
+    import time
+
+    models = {"push": _model("push"), "roll": _model("roll"), "spin": _model("spin")}
+    steps = [("push", 0.05)] * 4 + [("roll", 0.7)] + [("push", 0.04)] * 3 + [("spin", 0.3)] * 2
+    times = []
+    for seed in range(5):
+        t0 = time.perf_counter()
+        mc_odds(steps, models, budget=60, seed=seed)
+        times.append(time.perf_counter() - t0)
+    assert min(times) < 0.05  # ~3 ms on one idle core; generous for a loaded machine
