@@ -297,12 +297,15 @@ class Planner:
     def check_goal(self, goal: Goal, start_state: int) -> int:
         """The goal's resting state; raises :class:`GoalError` for goals that cannot be met: no free placement
         of the object anywhere in the goal's region (:meth:`aim`)."""
+        return self._checked_aim(goal, start_state)[0]
+
+    def _checked_aim(self, goal: Goal, start_state: int) -> tuple[int, Goal]:
+        """The goal's resting state and :meth:`aim` in it; raises :class:`GoalError` (see :meth:`check_goal`)."""
         goal.check_object(self.obj)
         state = start_state if goal.resting_state is None else goal.resting_state
         if not self.workspace.contains(goal.xy):
             raise GoalError(f"goal xy={goal.xy} is outside the workspace {self.workspace}")
-        self.aim(goal, state)
-        return state
+        return state, self.aim(goal, state)
 
     def aim(self, goal: Goal, state: int) -> Goal:
         """The point of the goal's region the plan aims at: the goal itself where the object fits there, else the
@@ -359,8 +362,7 @@ class Planner:
         deadline = t0 + self.time_limit
         asked = goal
         state, x, y, yaw = self.obj.planar_pose(T_start)
-        goal_state = self.check_goal(goal, state)
-        goal = self.aim(goal, goal_state)  # the free part of the goal's region
+        goal_state, goal = self._checked_aim(goal, state)  # the free part of the goal's region
         turn = not goal.yaw_free(self.obj, goal_state)  # whether the goal's yaw asks for anything
         route = self.graph.route(state, goal_state)
         if turn:

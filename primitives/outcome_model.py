@@ -14,7 +14,7 @@ left the object in another resting state counts 0.
 **Model**: the rollouts collected by ``python -m primitives.training.outcomes collect`` (each a strict ``p`` and the
 ``progress`` measured): a query ``p_strict`` takes the ``k`` (default 60) rollouts whose ``p`` is nearest, and
 :meth:`OutcomeModel.sample_progress` resamples their progress; :meth:`OutcomeModel.p_progress` is the share of
-them that made progress (``planner.execute.made_progress``'s criterion).
+them that made progress (:func:`primitives.params.made_progress`'s criterion).
 
 **Limits**: it conditions on ``p_strict`` only. The parameter is marginalised over the planner's distribution
 (push direction: irrelevant by the table's symmetry; spin ``|angle|`` between 15 and 45 deg; roll target), and so

@@ -305,3 +305,31 @@ def goal_flow(skill: str, params: dict | None, points: np.ndarray, T_world_objec
         return np.zeros((len(points), 3), dtype=np.float32)
     T = goal_transform(skill, params, T_world_object, obj)
     return (points @ T[:3, :3].T + T[:3, 3] - points).astype(np.float32)
+
+
+# What counts as a failed call for the executor's failure memory (planner.execute) and for the outcome models
+# (primitives.training.outcomes): a call that did not move the object the way it was
+# asked. The skills' own criteria are stricter (a push that slid 6 cm but turned 7 deg fails the seed's
+# push-straight); such a call still served the plan, and avoiding it sends the next plan round detours.
+MIN_PUSH_PROGRESS = 0.01  # metres along the asked direction
+MIN_SPIN_SHARE = 1.0 / 3.0  # of the asked turn, in the asked sense
+
+
+def made_progress(obj: ObjectModel, skill: str, params: Mapping, T_before: np.ndarray, T_after: np.ndarray) -> bool:
+    """Whether a call moved the object the way it was asked (see ``MIN_PUSH_PROGRESS``, ``MIN_SPIN_SHARE``).
+
+    A push moved it at least ``MIN_PUSH_PROGRESS`` along its direction in the same resting state; a spin
+    turned it at least ``MIN_SPIN_SHARE`` of the asked angle, in the asked sense, in the same state; a
+    roll left it in the target state.
+    """
+    s0, x0, y0, yaw0 = obj.planar_pose(T_before)
+    s1, x1, y1, yaw1 = obj.planar_pose(T_after)
+    if skill == "roll":
+        return s1 == params["target"]
+    if s1 != s0:
+        return False
+    if skill == "push":
+        a = params["direction"]
+        return (x1 - x0) * math.cos(a) + (y1 - y0) * math.sin(a) >= MIN_PUSH_PROGRESS
+    turn, asked = float(wrap_angle(yaw1 - yaw0)), params["angle"]
+    return turn * math.copysign(1.0, asked) >= MIN_SPIN_SHARE * abs(asked)

@@ -16,8 +16,7 @@ recording per row (:data:`COLUMNS`):
 
 - ``p``: the strict success probability; ``param``: the parameter's value (radians, or the target state);
 - ``success``: the strict criterion (:func:`primitives.rewards.success`) and a valid sample;
-- ``made_progress``: ``planner.execute.made_progress``'s criterion (:func:`made_progress`, a copy: primitives may
-  not import planner);
+- ``made_progress``: the executor's failure criterion (:func:`primitives.params.made_progress`);
 - ``progress``: the share of the asked effect achieved: push, displacement along the asked direction over
   ``PUSH_STEP`` (5 cm); spin, the turn in the asked sense over ``|angle|``; roll, 1 when it ended in the asked
   resting state, else 0. A push or spin that left the object in another resting state has progress 0 (the
@@ -97,36 +96,15 @@ from affordplan.log import cli_logging
 from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.sim.simulator import Simulator
 from primitives import params as skill_params
-from primitives.params import PUSH_STEP, SKILLS, SPIN_MAX, SPIN_MIN
+from primitives.params import PUSH_STEP, SKILLS, SPIN_MAX, SPIN_MIN, made_progress
 from primitives.skills import Skill, load_skills, skills_sensor
 from primitives.training.env import EnvConfig, _lru, object_groups
-
-# planner.execute's thresholds for "made progress" (copied: primitives may not import planner)
-MIN_PUSH_PROGRESS = 0.01  # metres along the asked direction
-MIN_SPIN_SHARE = 1.0 / 3.0  # of the asked turn, in the asked sense
 
 COLUMNS = {  # name: dtype
     "p": np.float32, "param": np.float32, "success": bool, "made_progress": bool, "progress": np.float32,
     "dx": np.float32, "dy": np.float32, "dyaw": np.float32, "state_before": np.int16, "state_after": np.int16,
     "state_asked": np.int16, "valid": bool, "object": np.int16,
 }
-
-
-def made_progress(obj: ObjectModel, skill: str, params: Mapping, T_before: np.ndarray, T_after: np.ndarray) -> bool:
-    """``planner.execute.made_progress``: a push moved the object at least ``MIN_PUSH_PROGRESS`` along its
-    direction in the same resting state; a spin turned it at least ``MIN_SPIN_SHARE`` of the asked angle, in the
-    asked sense, in the same state; a roll left it in the target state."""
-    s0, x0, y0, yaw0 = obj.planar_pose(T_before)
-    s1, x1, y1, yaw1 = obj.planar_pose(T_after)
-    if skill == "roll":
-        return s1 == params["target"]
-    if s1 != s0:
-        return False
-    if skill == "push":
-        a = params["direction"]
-        return (x1 - x0) * math.cos(a) + (y1 - y0) * math.sin(a) >= MIN_PUSH_PROGRESS
-    turn, asked = float(wrap_angle(yaw1 - yaw0)), params["angle"]
-    return turn * math.copysign(1.0, asked) >= MIN_SPIN_SHARE * abs(asked)
 
 
 def measure(obj: ObjectModel, skill: str, params: Mapping, T_before: np.ndarray, T_after: np.ndarray) -> dict:
