@@ -56,6 +56,7 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError, InputError
 from affordplan.log import cli_logging
+from affordplan.sim.sensor import SENSORS
 from primitives import weights_file
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
 from primitives.networks import HybridActorCritic
@@ -70,7 +71,7 @@ from primitives.success_model import (  # noqa: F401 (re-exported for training a
     load_success_net,
     member_input,
 )
-from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv
+from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, object_groups
 from primitives.training.neighbours import neighbour_outcomes
 
 
@@ -180,10 +181,11 @@ class _RolloutRows:
 
 @torch.no_grad()
 def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train", n_objects: int = 500,
-            seed: int = 0, p_params: float = 0.85, progress: bool = True) -> Rollouts:
-    """``n`` valid greedy rollouts of ``policy`` on a procedural split."""
+            seed: int = 0, p_params: float = 0.85, progress: bool = True, sensor: str = "cameras") -> Rollouts:
+    """``n`` valid greedy rollouts of ``policy`` on the objects ``split`` (:attr:`EnvConfig.objects`: a procedural
+    split, ``housekeep:SPLIT``, or several joined by ``+``), seen by ``sensor``."""
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
-                                 episodes_per_object=4), seed=seed)
+                                 episodes_per_object=4, sensor=sensor), seed=seed)
     rows = _RolloutRows()
     bar = tqdm(total=n, desc=f"rollouts {skill} ({split})", disable=not progress, unit="rollout", mininterval=2.0)
     while len(rows) < n:
@@ -203,7 +205,7 @@ def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train",
 @torch.no_grad()
 def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split: str = "train",
                          n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
-                         progress: bool = True) -> tuple[np.ndarray, Rollouts]:
+                         progress: bool = True, sensor: str = "cameras") -> tuple[np.ndarray, Rollouts]:
     """``n`` valid greedy rollouts acting in the frame of ``search`` (:class:`primitives.frames.FrameSearch`)
     that ``model`` rates likeliest.
 
@@ -213,7 +215,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
     """
     from primitives.policy import greedy_action
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
-                                 episodes_per_object=4), seed=seed)
+                                 episodes_per_object=4, sensor=sensor), seed=seed)
     rating, rows = [], _RolloutRows()
     bar = tqdm(total=n, desc=f"frame-search rollouts {skill} ({split})", disable=not progress, unit="rollout",
                mininterval=2.0)
@@ -236,7 +238,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
 @torch.no_grad()
 def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_start: int, split: str = "train",
                      n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
-                     progress: bool = True, neighbours: bool = False) -> Rollouts:
+                     progress: bool = True, neighbours: bool = False, sensor: str = "cameras") -> Rollouts:
     """``n`` valid greedy rollouts of ``policy``, ``per_start`` from each start: the start seen in that many of the
     options ``search`` rates for its request (:meth:`primitives.frames.FrameSearch.options`: its free frames, and
     for the seed's objective with stand-ins each stand-in request in its own free frames), drawn without
@@ -257,7 +259,7 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     noise, at five simulations a rollout.
     """
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
-                                 episodes_per_object=4), seed=seed)
+                                 episodes_per_object=4, sensor=sensor), seed=seed)
     rng = np.random.default_rng([seed, 1])  # the options drawn; apart from the environment's own stream
     rows = _RolloutRows()
     bar = tqdm(total=n, desc=f"frame-contrast rollouts {skill} ({split})", disable=not progress, unit="rollout",
@@ -606,6 +608,17 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--seed", type=int, default=0)
     f.add_argument("--out", default=None, help="folder for frames.json (default: runs/SKILL_frames)")
     f.add_argument("--json", action="store_true")
+    for name in ("train", "frames", "evaluate"):
+        default = "test" if name == "evaluate" else "train"
+        sub.choices[name].add_argument(
+            "--objects", default=default, metavar="OBJECTS",
+            help="objects the rollouts are drawn from: train | test (the procedural splits), housekeep:SPLIT (e.g. "
+                 "housekeep:training, housekeep:unseen), or several joined by + (each episode draws a group "
+                 f"uniformly) (default: {default})")
+        sub.choices[name].add_argument(
+            "--sensor", choices=SENSORS, default="cameras",
+            help="how the skill sees the object (surface: the privileged sample, for ablations) "
+                 "(default: %(default)s)")
     for name in ("train", "frames"):
         sub.choices[name].add_argument(
             "--workers", type=int, default=1,
@@ -616,9 +629,10 @@ def build_parser() -> argparse.ArgumentParser:
                                          help="judge the skill acting with this frame search (frames.json, or the "
                                               "shipped one): its calibrated ratings, and the searched success "
                                               "model's beside them")
-    sub.choices["evaluate"].add_argument("--searched", default=None, metavar="PATH",
+    sub.choices["evaluate"].add_argument("--searched", default=None, metavar="PATH", nargs="+",
                                          help="with --frames: the searched success model to judge (default: the "
-                                              "shipped one, if any)")
+                                              "shipped one, if any); more paths judge others on the same rollouts "
+                                              "(reported under other_searched_models)")
     sub.choices["train"].add_argument("--frames", default=None, metavar="shipped|PATH",
                                       help="train a searched success model: the skill acts with this frame search "
                                            "(frames.json, or the shipped one), the model rates it from the goal "
@@ -703,6 +717,7 @@ def main(argv: list[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     from primitives.policy import load_policy
 
+    check_objects(args.objects, fitting=args.command != "evaluate")
     if args.command == "frames":
         return _run_frames(args)
     contrast = None  # the options a frame-contrast start is executed in (checks --contrast-stand-ins first)
@@ -726,23 +741,24 @@ def _run(args: argparse.Namespace) -> int:
         elif contrast is not None:
             data = Rollouts.concat(collect_parallel(
                 collect_contrast, (policy, args.skill), args.rollouts, args.seed, args.workers,
-                progress=not args.json, search=contrast, per_start=args.contrast, split="train",
-                neighbours=args.neighbours))
+                progress=not args.json, search=contrast, per_start=args.contrast, split=args.objects,
+                neighbours=args.neighbours, sensor=args.sensor))
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model))
             data = Rollouts.concat([part[1] for part in collect_parallel(
                 collect_frame_search, (rater, args.skill), args.rollouts, args.seed, args.workers,
-                progress=not args.json, search=search, split="train")])
+                progress=not args.json, search=search, split=args.objects, sensor=args.sensor)])
         else:
             data = Rollouts.concat(collect_parallel(collect, (policy, args.skill), args.rollouts, args.seed,
-                                                    args.workers, progress=not args.json, split="train"))
+                                                    args.workers, progress=not args.json, split=args.objects,
+                                                    sensor=args.sensor))
         if not args.rollouts_from:
             data.save(cache)
         views = FrameViews.of(data, policy, args.skill, search, progress=not args.json) if args.views else None
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
                         views=views, encoder=args.encoder, rank_weight=args.rank_weight)
         info.update(skill=args.skill, rollouts=len(data) if args.rollouts_from else args.rollouts, seed=args.seed,
-                    workers=args.workers, policy=args.policy or "shipped")
+                    workers=args.workers, policy=args.policy or "shipped", objects=args.objects, sensor=args.sensor)
         if args.rollouts_from:
             info.update(rollouts_from=args.rollouts_from)
         if searched:
@@ -761,7 +777,8 @@ def _run(args: argparse.Namespace) -> int:
                            + (f" --workers {args.workers}" if args.workers > 1 else "")
                            + (f" --encoder {args.encoder}" if args.encoder != "cloud" else "")
                            + (f" --rank-weight {args.rank_weight:g}" if args.rank_weight else "")
-                           + (" --rollouts-from " + " ".join(args.rollouts_from) if args.rollouts_from else ""))
+                           + (" --rollouts-from " + " ".join(args.rollouts_from) if args.rollouts_from else "")
+                           + _objects_args(args))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
         return 0
@@ -769,16 +786,43 @@ def _run(args: argparse.Namespace) -> int:
     model = SuccessModel(policy, net)
     if args.frames is not None:
         return _evaluate_frames(args, model)
-    data = collect(policy, args.skill, args.rollouts, "test", n_objects=200, seed=args.seed, progress=not args.json)
+    data = collect(policy, args.skill, args.rollouts, args.objects, n_objects=200, seed=args.seed,
+                   progress=not args.json, sensor=args.sensor)
     with torch.no_grad():
         p = net(torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)).numpy()
-    result = dict(skill=args.skill, objects="test split (never trained on)", all=metrics(p, data.success),
+    result = dict(skill=args.skill, objects=_objects_label(args.objects), sensor=args.sensor,
+                  all=metrics(p, data.success),
                   parameterised=metrics(p[data.parameterised], data.success[data.parameterised]),
                   query_ms=1e3 * bench_query(model.predict, data.obs[0].astype(np.float32)))
     if args.plot:
-        plot_reliability(p, data.success, args.plot, f"{args.skill} success model, unseen objects")
+        plot_reliability(p, data.success, args.plot, f"{args.skill} success model, {args.objects}, {args.sensor}")
     print(json.dumps(result, indent=2))
     return 0
+
+
+HELD_OUT = ("test", "housekeep:unseen", "housekeep:unseen_thick", "housekeep:unseen_instance",
+            "housekeep:unseen_class", "housekeep:unseen_instance_thick", "housekeep:unseen_class_thick")
+
+
+def check_objects(objects: str, fitting: bool) -> None:
+    """Raise :class:`InputError` for an ``--objects`` naming no objects, or, when ``fitting`` (a model or a
+    calibration is fitted on them), naming a held-out split: test objects are never trained, tuned or selected on."""
+    object_groups(objects, 1)
+    held_out = [spec for spec in objects.split("+") if spec in HELD_OUT]
+    if fitting and held_out:
+        raise InputError(f"--objects {objects}: {', '.join(held_out)} is held out for evaluation; fit on train, "
+                         "housekeep:training or housekeep:validation")
+
+
+def _objects_args(args: argparse.Namespace) -> str:
+    """The ``--objects`` / ``--sensor`` part of a recorded command (empty where they are the defaults)."""
+    return ((f" --objects {args.objects}" if args.objects != "train" else "")
+            + (f" --sensor {args.sensor}" if args.sensor != "cameras" else ""))
+
+
+def _objects_label(objects: str) -> str:
+    """How a report names the objects its rollouts came from."""
+    return "test split (never trained on)" if objects == "test" else objects
 
 
 def _run_frames(args: argparse.Namespace) -> int:
@@ -792,7 +836,7 @@ def _run_frames(args: argparse.Namespace) -> int:
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
     parts = collect_parallel(collect_frame_search, (model, args.skill), args.rollouts, args.seed, args.workers,
-                             progress=not args.json, search=search, split="train")
+                             progress=not args.json, search=search, split=args.objects, sensor=args.sensor)
     rating, data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
     success, par = data.success, data.parameterised
     platt = fit_frame_calibration(rating[par], success[par])
@@ -800,7 +844,7 @@ def _run_frames(args: argparse.Namespace) -> int:
     search = replace(search, platt=platt, platt_unparameterised=platt_seed)
     p = search.calibrate(rating, par)
     info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
-                policy=args.policy or "shipped",
+                policy=args.policy or "shipped", objects=args.objects, sensor=args.sensor,
                 model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
                 frames_seed_objective=len(search.frames(args.skill, None)),
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
@@ -808,7 +852,8 @@ def _run_frames(args: argparse.Namespace) -> int:
     if asked.stand_ins:  # the seed's objective alone, acting through the stand-ins as well: their own calibration
         search = replace(search, stand_ins=asked.stand_ins)
         parts = collect_parallel(collect_frame_search, (model, args.skill), args.stand_in_rollouts, args.seed,
-                                 args.workers, progress=not args.json, search=search, split="train", p_params=0.0)
+                                 args.workers, progress=not args.json, search=search, split=args.objects, p_params=0.0,
+                                 sensor=args.sensor)
         score, seed_data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
         search = replace(search, platt_stand_ins=fit_frame_calibration(score, seed_data.success))
         info.update(stand_ins=args.stand_ins, stand_in_rollouts=args.stand_in_rollouts,
@@ -822,7 +867,8 @@ def _run_frames(args: argparse.Namespace) -> int:
                         f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts}"
                         + (f" --stand-ins {args.stand_ins} --stand-in-rollouts {args.stand_in_rollouts}"
                            if args.stand_ins else "") +
-                        f" --seed {args.seed}{f' --workers {args.workers}' if args.workers > 1 else ''}")
+                        f" --seed {args.seed}{f' --workers {args.workers}' if args.workers > 1 else ''}"
+                        + _objects_args(args))
     search = replace(search, info=info)
     search.save(out / "frames.json")
     print((out / "frames.json").read_text())
@@ -834,32 +880,39 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
     same rollouts: the calibrated rating of the chosen frame, and the searched success model, which rates the
     searched skill from the goal frame alone (the shipped ``{skill}_success_searched.pt``, or ``--searched``)."""
     search = load_frame_search(args.skill, args.frames)
-    rating, data = collect_frame_search(model, args.skill, args.rollouts, search, "test", n_objects=200,
-                                        seed=args.seed, progress=not args.json)
+    rating, data = collect_frame_search(model, args.skill, args.rollouts, search, args.objects, n_objects=200,
+                                        seed=args.seed, progress=not args.json, sensor=args.sensor)
     success, par = data.success, data.parameterised
     p = search.calibrate(rating, par)
     obs = data.obs[0].astype(np.float32)
     frames = search.frames(args.skill, {})
-    result = dict(skill=args.skill, objects="test split (never trained on)", frames=args.frames,
+    result = dict(skill=args.skill, objects=_objects_label(args.objects), sensor=args.sensor, frames=args.frames,
                   all=metrics(p, success), parameterised=metrics(p[par], success[par]),
                   seed_objective=metrics(p[~par], success[~par]) if (~par).any() else None,
                   query_ms=1e3 * bench_query(model.predict, reframe_obs(obs, frames)),
                   frames_per_query=len(frames))
-    searched_path = (Path(args.searched) if args.searched
-                     else weights_file.SHIPPED_DIR / f"{args.skill}_success_searched.pt")
-    if args.searched or searched_path.exists():
+    searched_paths = ([Path(path) for path in args.searched] if args.searched
+                      else [weights_file.SHIPPED_DIR / f"{args.skill}_success_searched.pt"])
+    for i, searched_path in enumerate(searched_paths):
+        if not (args.searched or searched_path.exists()):
+            break
         searched = SuccessModel(model.policy, load_success_net(args.skill, searched_path))
         with torch.no_grad():
-            q = searched.net(torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)).numpy()
-        result["searched_model"] = dict(path=str(searched_path.name), all=metrics(q, success),
-                                        parameterised=metrics(q[par], success[par]),
-                                        query_ms=1e3 * bench_query(searched.predict, obs))
+            q_i = searched.net(torch.from_numpy(data.obs.astype(np.float32)),
+                               torch.from_numpy(data.decision)).numpy()
+        report = dict(path=str(searched_path if i else searched_path.name), all=metrics(q_i, success),
+                      parameterised=metrics(q_i[par], success[par]))
+        if i == 0:
+            q = q_i
+            result["searched_model"] = dict(report, query_ms=1e3 * bench_query(searched.predict, obs))
+        else:
+            result.setdefault("other_searched_models", []).append(report)
     if args.plot:
-        plot_reliability(p, success, args.plot, f"{args.skill} success model, frame search, unseen objects")
+        plot_reliability(p, success, args.plot, f"{args.skill} success model, frame search, {args.objects}, {args.sensor}")
         if "searched_model" in result:
             path = Path(args.plot)
             plot_reliability(q, success, path.with_name(path.stem + "_searched" + path.suffix),
-                             f"{args.skill} searched success model, unseen objects")
+                             f"{args.skill} searched success model, {args.objects}, {args.sensor}")
     print(json.dumps(result, indent=2))
     return 0
 
