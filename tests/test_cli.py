@@ -218,3 +218,10 @@ def test_bench_query_times_a_candidate_folder_and_refuses_a_missing_one(capsys, 
     assert "is not a folder" in captured.err and captured.out == ""
 
 
+
+
+def test_video_quality_choices_are_the_recorders():
+    from affordplan.app.cli import VIDEO_QUALITIES
+    from affordplan.app.video import QUALITIES
+
+    assert VIDEO_QUALITIES == QUALITIES

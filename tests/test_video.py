@@ -115,19 +115,19 @@ def test_background_frames_equal_those_drawn_at_once(cube):
 
 
 def test_a_frame_looks_as_mujocos_renderer_draws_it(cube, monkeypatch):
-    """The recorder's own context (sized to the frame, drawn on another thread) draws what ``mujoco.Renderer``
-    draws: the same pixels with the scene's shadow map, and nearly so with the smaller one it uses by default."""
+    """At quality "full" the recorder's own context (sized to the frame, drawn on another thread) draws what
+    ``mujoco.Renderer`` draws: the same pixels with the scene's shadow map, and nearly so with the smaller one it uses by default."""
     sim = ap.Simulator(cube, seed=0)
     renderer = mujoco.Renderer(sim.model, H, W)
     try:
         renderer.update_scene(sim.data, camera="overview")
         reference = renderer.render().copy()
         monkeypatch.setattr(video, "SHADOW_MAP_PER_PIXEL", 10_000)
-        rec = FrameRecorder(sim, W, H, camera="overview")
+        rec = FrameRecorder(sim, W, H, camera="overview", quality="full")
         assert np.array_equal(rec.capture(), reference)
         rec.close()
         monkeypatch.undo()
-        rec = FrameRecorder(sim, W, H, camera="overview")
+        rec = FrameRecorder(sim, W, H, camera="overview", quality="full")
         diff = np.abs(rec.capture().astype(int) - reference).max(axis=2)
         rec.close()
         assert (diff > 16).mean() < 0.01
@@ -192,17 +192,47 @@ def test_frame_interval_counts_whole_chunks(cube):
     sim.close()
 
 
-def test_fast_quality_draws_the_same_scene_without_multisampling_or_reflections(cube):
+def _orange(frame: np.ndarray) -> np.ndarray:
+    """The pixels of the orange cube (the table is grey)."""
+    rgb = frame.astype(int)
+    return rgb[..., 0] - rgb[..., 2] > 60
+
+
+def _iou(a: np.ndarray, b: np.ndarray) -> float:
+    return float((a & b).sum() / max(1, (a | b).sum()))
+
+
+def test_qualities_draw_the_same_scene(cube):
+    """standard (the default) and fast draw the picture full draws, without shadows and gloss (fast: without
+    multisampling, so its edges differ from standard's)."""
     sim = ap.Simulator(cube, seed=0)
-    full = FrameRecorder(sim, W, H, camera="overview")
-    fast = FrameRecorder(sim, W, H, camera="overview", quality="fast")
+    recorders = {q: FrameRecorder(sim, W, H, camera="overview", quality=q) for q in ("full", "standard", "fast")}
+    assert FrameRecorder(sim, W, H, camera="overview").quality == "standard"
     try:
-        a, b = full.capture(), fast.capture()
-        assert b.shape == (H, W, 3) and b.dtype == np.uint8 and not np.array_equal(a, b)
-        assert np.abs(a.astype(int) - b.astype(int)).mean() < 8  # the same picture, edges and gloss aside
+        frames = {q: r.capture() for q, r in recorders.items()}
+        for q in ("standard", "fast"):
+            assert frames[q].shape == (H, W, 3) and frames[q].dtype == np.uint8
+            assert not np.array_equal(frames[q], frames["full"])
+            assert _iou(_orange(frames[q]), _orange(frames["full"])) > 0.9  # the cube where full draws it
+        diff = np.abs(frames["fast"].astype(int) - frames["standard"].astype(int)).max(axis=-1)
+        assert 0 < (diff > 0).mean() < 0.2  # only edges change when multisampling goes
     finally:
-        full.close()
-        fast.close()
+        for r in recorders.values():
+            r.close()
         sim.close()
     with pytest.raises(InputError, match="quality"):
         FrameRecorder(sim, W, H, camera="overview", quality="best")
+
+
+def test_take_queues_a_frame_in_its_turn_and_returns_it_later(cube):
+    sim, rec, _ = _record(cube, frame_interval=0.1)
+    try:
+        before = len(rec.frames)
+        pending = rec.take()
+        assert callable(pending)
+        frame = pending()
+        assert frame.shape == (H, W, 3) and frame.dtype == np.uint8
+        assert len(rec.frames) == before + 1 and np.array_equal(rec.frames[-1], frame)  # its place, in order
+    finally:
+        rec.close()
+        sim.close()

@@ -15,6 +15,8 @@ import textwrap
 
 from affordplan.robot import SKILLS
 
+VIDEO_QUALITIES = ("standard", "full", "fast")  # affordplan.app.video.QUALITIES, without importing the renderer
+
 EXAMPLES = """\
 examples:
   affordplan demo                          # the mug: flip upright, through the gap, turn; ./affordplan-demo/
@@ -65,7 +67,7 @@ def _run_kwargs(args: argparse.Namespace) -> dict:
     return dict(sim=args.sim, planner=args.planner, max_primitives=args.max_primitives, seed=args.seed,
                 time_limit=args.time_limit, video=not args.no_video, width=args.width, height=args.height,
                 fps=args.fps, frame_interval=args.frame_interval, camera=args.camera, viewer=args.viewer,
-                progress=not args.quiet, weights_dir=args.weights_dir)
+                quality=args.quality, progress=not args.quiet, weights_dir=args.weights_dir)
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
@@ -200,8 +202,12 @@ def _add_run_options(p: argparse.ArgumentParser, out_default: str | None, max_pr
                        help="frame height, pixels (default: %(default)s)")
     video.add_argument("--fps", type=_bounded_float(0.0, 240.0, "frames per second"), default=10.0,
                        help="video frame rate (default: %(default)s)")
-    video.add_argument("--frame-interval", type=_bounded_float(0.0, 10.0, "seconds"), default=0.25, metavar="S",
+    video.add_argument("--frame-interval", type=_bounded_float(0.0, 10.0, "seconds"), default=0.5, metavar="S",
                        help="simulated seconds between frames (default: %(default)s)")
+    video.add_argument("--quality", choices=VIDEO_QUALITIES, default="standard",
+                       help="standard: multisampled, no shadows or reflections; full: as MuJoCo draws the scene "
+                            "(about three times the drawing time); fast: standard without multisampling "
+                            "(default: %(default)s)")
     p.add_argument("--viewer", action="store_true",
                    help="also show MuJoCo's interactive viewer (needs a display; on macOS run under mjpython)")
     p.add_argument("--check", action="store_true", help="exit with status 1 when the goal is not reached")

@@ -74,13 +74,13 @@ class _Watch:
         self.hull = obj.hull.vertices
         self.executed = 0
         self.off_table: list[tuple[int, float]] = []
-        self.keyframes: list[tuple[str, np.ndarray]] = []
+        self.keyframes: list[tuple[str, Callable[[], np.ndarray | None]]] = []  # drawn in the background
         self._steps_seen = -1
         self.bar = tqdm(total=max_primitives, desc=f"executing ({label})", unit="prim", disable=not progress)
 
     def start(self, sim: Simulator) -> None:
         self._steps_seen = sim.physics_steps
-        if self.recorder is not None and (f := self.recorder.capture()) is not None:
+        if self.recorder is not None and (f := self.recorder.take()) is not None:
             self.keyframes.append(("start", f))
 
     def after_primitive(self, sim: Simulator) -> None:
@@ -89,7 +89,7 @@ class _Watch:
         if lowest > OFF_TABLE_HEIGHT:
             self.off_table.append((self.executed, lowest))
         if self.recorder is not None:
-            if sim.physics_steps > self._steps_seen and (f := self.recorder.capture()) is not None:
+            if sim.physics_steps > self._steps_seen and (f := self.recorder.take()) is not None:
                 self.keyframes.append((f"after primitive {self.executed}", f))
             self.bar.set_postfix(frames=len(self.recorder.frames), refresh=False)
         self._steps_seen = sim.physics_steps
@@ -139,8 +139,8 @@ class SceneRun:
 def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: str = "affordplan",
               max_primitives: int = DEMO_MAX_PRIMITIVES, seed: int = 0, time_limit: float = 5.0,
               video: bool = True, width: int = 480, height: int = 360, fps: float = 10.0,
-              frame_interval: float = 0.25, camera: str | None = None, viewer: bool = False,
-              progress: bool = True, echo: Callable[[str], None] = print,
+              frame_interval: float = 0.5, camera: str | None = None, viewer: bool = False,
+              quality: str = "standard", progress: bool = True, echo: Callable[[str], None] = print,
               weights_dir: str | Path | None = None) -> SceneRun:
     """Plan and execute ``scene``, print the plan and the outcome, write the outputs to ``out_dir``.
 
@@ -159,6 +159,8 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
         camera: ``"arm"`` (the whole arm), or a scene camera: ``"overview"`` (closer), ``"wide"``, ``"top"``;
             ``None``: ``"arm"`` with the arm, ``"overview"`` with the finger.
         viewer: also show MuJoCo's interactive viewer when a display exists.
+        quality: how the video's frames are drawn (:class:`~affordplan.app.video.FrameRecorder`): ``"standard"``,
+            ``"full"`` (shadows and reflections; about three times the drawing time) or ``"fast"``.
         progress: show a progress bar (primitives executed, frames rendered) on stderr.
         echo: where the report lines go.
         weights_dir: run the skills from this folder's files instead of the shipped ones, e.g. a candidate set
@@ -210,7 +212,7 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
     simulator = _NotifyingSimulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed, sensor=sensor)
     simulator.set_object_pose(plan.start_pose)
     camera = camera or ("arm" if sim == "arm" else "overview")
-    recorder = FrameRecorder(simulator, width, height, camera, frame_interval) if video else None
+    recorder = FrameRecorder(simulator, width, height, camera, frame_interval, quality=quality) if video else None
     live = None
     if viewer:
         from affordplan.app.viewer import open_viewer
@@ -260,7 +262,8 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
 
 
 def _write_outputs(run: SceneRun, obj: ObjectModel, out: Path, recorder: FrameRecorder | None,
-                   keyframes: list[tuple[str, np.ndarray]], fps: float, t_start: float) -> None:
+                   keyframes: list[tuple[str, Callable[[], np.ndarray | None]]], fps: float,
+                   t_start: float) -> None:
     """summary.json, then plan.png, frames.png and the video (when frames were rendered), then summary.json again
     with every file and the whole time; fills ``run.files``."""
     from planner.plot import plot_plan
@@ -275,7 +278,8 @@ def _write_outputs(run: SceneRun, obj: ObjectModel, out: Path, recorder: FrameRe
               title=f"{run.scene.name}: {obj.name}, {'goal reached' if ex.success else 'goal NOT reached'} "
                     f"after {ex.n_primitives} primitives, {ex.replans} replans")
     if recorder is not None and recorder.frames:
-        run.files["frames"] = save_strip(keyframes, out / "frames.png", n=6)
+        drawn = [(label, frame) for label, take in keyframes if (frame := take()) is not None]
+        run.files["frames"] = save_strip(drawn, out / "frames.png", n=6)
         hold = [recorder.frames[-1]] * max(1, round(END_HOLD_S * fps))
         run.files["video"] = write_video(recorder.frames + hold, out / "video.mp4", fps=fps)
     run.files["summary"] = out / "summary.json"

@@ -9,9 +9,11 @@ simulating thread; drawing it (``mjr_render`` and reading the pixels back, 50-15
 Mesa's software rasteriser) happens on one background thread with one OpenGL context per recording,
 while the simulation and the planner go on (MuJoCo releases the GIL while it draws). The context's
 offscreen buffer is the frame's size rather than the scene's 1280x960 (MuJoCo clears and resolves all of it
-every frame), and its shadow map is at most :data:`SHADOW_MAP_PER_PIXEL` times the frame's longer side;
-``quality="fast"`` also drops multisampling and reflections. ``python -m affordplan.app.video --bench``
-times the demo's execution with and without video.
+every frame). What it draws is the ``quality`` (:data:`QUALITIES`): ``"standard"`` (the default) is multisampled,
+without the table's reflection and without shadows, about 12 ms a 480x360 frame with Mesa's software rasteriser;
+``"full"`` draws the scene as MuJoCo does (shadows and reflection, about 40 ms: the shadow pass is most of it);
+``"fast"`` also drops multisampling (about 5 ms, jagged edges). ``python -m affordplan.app.video --bench`` times the
+demo's execution with and without video.
 
 Cameras: the scene's fixed ones (``overview``, ``wide``, ``top``, see :mod:`affordplan.sim.scene`) or
 the free views in :data:`FREE_CAMERAS` (``arm``: the whole arm and the workspace in front of it).
@@ -40,8 +42,8 @@ FREE_CAMERAS: dict[str, dict] = {
 }
 SHADOW_MAP_PER_PIXEL = 2  # shadow-map texels per pixel of the frame's longer side (the scene's map when smaller)
 PENDING_FRAMES = 16  # frames taken but not drawn yet, at most: the simulation waits beyond that
-QUALITIES = ("full", "fast")
-FAST_PLANE_GRID = 0.1  # metres: the coarsest grid a plane is drawn with at quality "fast"
+QUALITIES = ("standard", "full", "fast")
+PLANE_GRID = 0.1  # metres: the coarsest grid a plane is drawn with below quality "full"
 
 
 def camera_names(sim: Simulator) -> list[str]:
@@ -163,12 +165,13 @@ class _Drawer:
         model.vis.global_.offwidth, model.vis.global_.offheight = self.width, self.height
         vq = model.vis.quality
         vq.shadowsize = min(int(vq.shadowsize), SHADOW_MAP_PER_PIXEL * max(self.width, self.height))
-        if self.quality == "fast":
-            vq.offsamples = 0  # no multisampling
+        if self.quality != "full":
             # MuJoCo lights per vertex: a plane is drawn as a grid of its third size; a 10 cm grid changes no pixel
             # of the demo by more than 7/255 and halves the table's vertices
             planes = model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE
-            model.geom_size[planes, 2] = np.maximum(model.geom_size[planes, 2], FAST_PLANE_GRID)
+            model.geom_size[planes, 2] = np.maximum(model.geom_size[planes, 2], PLANE_GRID)
+        if self.quality == "fast":
+            vq.offsamples = 0  # no multisampling
         gl_cls = getattr(mujoco, "GLContext", None)
         gl = gl_cls(self.width, self.height) if gl_cls is not None else None
         if gl is not None:
@@ -179,8 +182,9 @@ class _Drawer:
         return gl, con
 
     def _draw(self, con: mujoco.MjrContext, scene: mujoco.MjvScene) -> np.ndarray:
-        if self.quality == "fast":
+        if self.quality != "full":
             scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+            scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
         rect = mujoco.MjrRect(0, 0, self.width, self.height)
         mujoco.mjr_render(rect, scene, con)
         rgb = np.empty((self.height, self.width, 3), dtype=np.uint8)
@@ -200,10 +204,12 @@ class FrameRecorder:
             480x360 take 311 MB).
         background: draw the frames on a background thread while the simulation goes on (the default);
             ``False`` draws each frame before :meth:`on_chunk` returns.
-        quality: ``"full"``: the scene as MuJoCo draws it (multisampled, with shadows and the table's reflection;
-            the shadow map at most :data:`SHADOW_MAP_PER_PIXEL` texels per pixel of the longer side, which changes
-            no visible detail). ``"fast"``: without multisampling (jagged edges) and reflections (the table looks
-            matte), shadows kept: about half the drawing time with Mesa's software rasteriser.
+        quality: ``"standard"``: multisampled, without shadows and without the table's reflection (the table
+            looks matte), about a third of ``"full"``'s drawing time with Mesa's software rasteriser, so that
+            recording costs little beside the simulation. ``"full"``: the scene as MuJoCo draws it (with shadows
+            and the reflection; the shadow map at most :data:`SHADOW_MAP_PER_PIXEL` texels per pixel of the longer
+            side, which changes no visible detail). ``"fast"``: as ``"standard"`` without multisampling (jagged
+            edges), about half its time again.
 
     The frames taken by :meth:`on_chunk` are drawn in the background, at most :data:`PENDING_FRAMES` behind.
     :attr:`frames` holds them in order: while the simulator's ``on_chunk`` still calls this recorder
@@ -215,8 +221,8 @@ class FrameRecorder:
     """
 
     def __init__(self, sim: Simulator, width: int = 480, height: int = 360, camera: str = "arm",
-                 frame_interval: float = 0.25, max_frames: int = 600, background: bool = True,
-                 quality: str = "full"):
+                 frame_interval: float = 0.5, max_frames: int = 600, background: bool = True,
+                 quality: str = "standard"):
         vis = sim.model.vis.global_
         if not (isinstance(width, int) and isinstance(height, int) and 16 <= width <= vis.offwidth
                 and 16 <= height <= vis.offheight):
@@ -298,10 +304,21 @@ class FrameRecorder:
         """Take one frame now and return it drawn; ``None`` when rendering is unavailable or the budget is spent.
 
         It is drawn ahead of the frames still pending (it keeps its place in :attr:`frames`)."""
-        taken = self._take(urgent=True)
-        if taken is None:
+        pending = self._take(urgent=True)
+        return None if pending is None else self._result(*pending)
+
+    def take(self) -> Callable[[], np.ndarray | None] | None:
+        """Take one frame now without waiting for it to be drawn (it is drawn in its turn, as the frames
+        :meth:`on_chunk` takes are): returns a function that waits for it and returns it (``None`` when rendering
+        failed), or ``None`` when rendering is unavailable or the budget is spent. The demo takes its key frames
+        this way, so that the simulation never waits for the drawing."""
+        pending = self._take(urgent=False)
+        if pending is None:
             return None
-        drawer, index = taken
+        drawer, index = pending
+        return lambda: self._result(drawer, index)
+
+    def _result(self, drawer: _Drawer, index: int) -> np.ndarray | None:
         drawer.wait(index)
         frame = drawer.slots[index]
         if frame is _DROPPED:
@@ -419,14 +436,15 @@ def _write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
 
 # ------------------------------------------------------------------------------- benchmark
 def bench(repeats: int = 5, max_primitives: int = 30, sim: str = "arm", seed: int = 0, time_limit: float = 5.0,
-          width: int = 480, height: int = 360, frame_interval: float = 0.25, fps: float = 10.0,
-          quality: str = "full", echo: Callable[[str], None] = print) -> dict:
+          width: int = 480, height: int = 360, frame_interval: float = 0.5, fps: float = 10.0,
+          quality: str = "standard", echo: Callable[[str], None] = print) -> dict:
     """Time the demo scene's execution without and with video: ``repeats`` rounds of one run each way (the order
     alternating), same seed, so that both runs of a round see the same load on the machine.
 
     Each run plans afresh, untimed (the same plan every time: same seed; a fresh planner, as ``affordplan demo`` has,
     since a planner caches what it predicts), then executes the plan, timed, recording as the demo does (a frame
-    every ``frame_interval`` simulated seconds and one after every primitive) and waiting for the last frame drawn;
+    every ``frame_interval`` simulated seconds and one after every primitive, :meth:`FrameRecorder.take`) and waiting
+    for the last frame drawn;
     the video is then written, timed apart.
 
     Returns ``{"without": [s, ...], "with": [s, ...], "encode": [s, ...], "ratio": median with / median without,
@@ -454,7 +472,7 @@ def bench(repeats: int = 5, max_primitives: int = 30, sim: str = "arm", seed: in
                 return super().execute(contact, motion, normal=normal)
             finally:
                 if self.recorder is not None:
-                    self.recorder.capture()
+                    self.recorder.take()
 
     def run(video: bool) -> tuple[float, float, int, int]:
         plan = ap.plan(obj, scene.goal, start=scene.start, obstacles=scene.obstacles, time_limit=time_limit,
@@ -515,8 +533,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="(default: %(default)s)")
     parser.add_argument("--width", type=int, default=480, help="(default: %(default)s)")
     parser.add_argument("--height", type=int, default=360, help="(default: %(default)s)")
-    parser.add_argument("--frame-interval", type=float, default=0.25, help="(default: %(default)s)")
-    parser.add_argument("--quality", choices=QUALITIES, default="full", help="(default: %(default)s)")
+    parser.add_argument("--frame-interval", type=float, default=0.5, help="(default: %(default)s)")
+    parser.add_argument("--quality", choices=QUALITIES, default="standard", help="(default: %(default)s)")
     args = parser.parse_args(argv)
     if args.repeats < 1 or args.max_primitives < 1:
         parser.error("--repeats and --max-primitives must be at least 1")
