@@ -116,7 +116,8 @@ def test_background_frames_equal_those_drawn_at_once(cube):
 
 def test_a_frame_looks_as_mujocos_renderer_draws_it(cube, monkeypatch):
     """At quality "full" the recorder's own context (sized to the frame, drawn on another thread) draws what
-    ``mujoco.Renderer`` draws: the same pixels with the scene's shadow map, and nearly so with the smaller one it uses by default."""
+    ``mujoco.Renderer`` draws: the same pixels with the scene's shadow map, and nearly so with the smaller one it
+    uses by default."""
     sim = ap.Simulator(cube, seed=0)
     renderer = mujoco.Renderer(sim.model, H, W)
     try:

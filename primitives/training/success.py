@@ -908,7 +908,8 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
         else:
             result.setdefault("other_searched_models", []).append(report)
     if args.plot:
-        plot_reliability(p, success, args.plot, f"{args.skill} success model, frame search, {args.objects}, {args.sensor}")
+        plot_reliability(p, success, args.plot,
+                         f"{args.skill} success model, frame search, {args.objects}, {args.sensor}")
         if "searched_model" in result:
             path = Path(args.plot)
             plot_reliability(q, success, path.with_name(path.stem + "_searched" + path.suffix),
