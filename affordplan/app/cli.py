@@ -477,7 +477,7 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--draw", type=_nonnegative_int, default=0, metavar="K",
                     help="run the same tasks with the planner's and the simulator's random numbers drawn afresh "
                          "(K > 0; 0, the default, is the standard run): how far outcomes move by chance alone")
-    bp.add_argument("--objects", default="procedural", choices=["procedural", "household", "mixed"],
+    bp.add_argument("--objects", default="procedural", choices=["procedural", "household", "mixed", "training"],
                     help="the tasks' objects: the procedural test split, HACMan's 25 unseen household meshes, or "
                          "the two by turns (default: %(default)s)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")

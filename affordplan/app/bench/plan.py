@@ -41,8 +41,10 @@ OBJECTS_PER_SEED = 1000
 # into them, and every push there, rarely succeeds); they stay in the tasks and in the success rate.
 RARE_GOAL_STATE = 0.05
 # What the tasks' objects are: the procedural test split, HACMan's unseen household meshes (never trained on,
-# housekeep.names("unseen")), or the two by turns (even tasks procedural, odd ones household).
-OBJECT_SETS = ("procedural", "household", "mixed")
+# housekeep.names("unseen")), or the two by turns (even tasks procedural, odd ones household); "training": the
+# training objects by turns (procedural train split, housekeep.names("training")), for fitting what the planner
+# learns from plan outcomes (planner.odds.STUCK_RATE), never for reporting.
+OBJECT_SETS = ("procedural", "household", "mixed", "training")
 
 
 @dataclass
@@ -76,6 +78,8 @@ class TaskResult:
     expected_primitives: float = float("nan")
     max_planning_time: float = float("nan")  # the longest of the first plan and the replans, seconds
     object_name: str = ""
+    # the first plan's steps as its odds see them: (skill, predicted success of one try); empty for greedy
+    steps: list[tuple[str, float]] = field(default_factory=list)
 
 
 @dataclass
@@ -155,13 +159,14 @@ def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...
 
 def task_object(index: int, objects: str = "procedural") -> ObjectModel:
     """Task ``index``'s object (:data:`OBJECT_SETS`): procedural test object ``index``, or unseen household mesh
-    ``index`` (cycling through the 25); ``"mixed"`` takes the household one for odd indices."""
+    ``index`` (cycling through the 25); ``"mixed"`` takes the household one for odd indices; ``"training"`` as
+    ``"mixed"`` from the training objects (procedural train split, household training meshes)."""
     if objects not in OBJECT_SETS:
         raise InputError(f"objects must be one of {OBJECT_SETS}, got {str(objects)[:40]!r}")
-    if objects == "household" or (objects == "mixed" and index % 2):
-        names = housekeep.names("unseen")
+    if objects == "household" or (objects in ("mixed", "training") and index % 2):
+        names = housekeep.names("training" if objects == "training" else "unseen")
         return load_object(f"housekeep/{names[index % len(names)]}")
-    return random_object(index, "test")
+    return random_object(index, "train" if objects == "training" else "test")
 
 
 def make_task(rng: np.random.Generator, index: int, workspace: Workspace = Workspace(),
@@ -242,7 +247,8 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
         float("nan"), float("nan"))
     return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal,
                       float(xy_error), float(yaw_error), missed, p_success=predicted[0],
-                      expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name)
+                      expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name,
+                      steps=[(s.skill, float(s.p_success)) for s in p.steps] if planner_name == "affordplan" else [])
 
 
 def _describe(task: Task) -> str:
