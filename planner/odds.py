@@ -18,6 +18,13 @@ gives up on is replaced by another. ``affordplan bench plan`` compares the predi
 moved 3.5 cm did most of its job and the executor replans from there. :func:`mc_odds` instead draws what each
 primitive achieves from the skill's outcome model (:class:`primitives.outcome_model.OutcomeModel`: the share of the
 asked effect, given the step's strict probability) and counts the primitives until the plan's effect is achieved.
+
+**Stuck steps.** Retries are not independent: a roll that fails on this object because the fingertip cannot get under
+it fails again, and a push against a clamp stays clamped. Treating every try as a fresh draw makes a long budget look
+like certain success (0.23's plans all predicted 1.00 and reached 0.83). :func:`mc_odds` therefore lets each step of a
+run be *stuck* with probability ``stuck_rate * (1 - q)`` (``q``: the step's predicted success of one try): a stuck
+step makes no progress however often it is tried. ``stuck_rate`` is one number, fitted to plan outcomes on training
+objects (:data:`STUCK_RATE`, :func:`fit_stuck_rate`).
 """
 
 from __future__ import annotations
@@ -36,6 +43,10 @@ if TYPE_CHECKING:
 
 DEFAULT_BUDGET = 60  # primitives: Plan.execute's default max_primitives
 Q_FLOOR = 0.02  # a step rated below this is treated as this: the executor replaces a step that keeps failing
+# P(a step is stuck in a run) = STUCK_RATE * (1 - q). Fitted by fit_stuck_rate to the first plans of
+# `affordplan bench plan --objects training --fit-stuck` (training objects only; the command and the figures:
+# docs/guide.md, "A plan's odds").
+STUCK_RATE = 0.0
 
 
 @dataclass(frozen=True)
@@ -78,7 +89,7 @@ def plan_odds(step_probabilities: Sequence[float], budget: int = DEFAULT_BUDGET)
 
 
 def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeModel], budget: int = DEFAULT_BUDGET,
-            seed: int = 0, n: int = 2000) -> Odds:
+            seed: int = 0, n: int = 2000, stuck_rate: float = STUCK_RATE) -> Odds:
     """The :class:`Odds` of a plan by Monte Carlo through the skills' outcome models.
 
     ``steps``: the plan's ``(skill, strict p)`` in order; ``models``: an outcome model per skill used, anything with
@@ -90,7 +101,8 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     consecutive steps of one skill, so a surplus carries over to the next step of the same skill (a push of 7 cm
     covers 1.4 push steps) but not across a change of skill; a roll counts only when it reached its state (a
     progress of at least 1 counts 1, less counts 0). ``p_success`` is the share of runs done within ``budget``
-    primitives, ``expected_primitives`` their mean, counting a run that is not done as ``budget``.
+    primitives, ``expected_primitives`` their mean, counting a run that is not done as ``budget``. In each run, each
+    step is stuck (makes no progress at all) with probability ``stuck_rate * (1 - p)`` (the module docstring).
 
     Each step's draws come from a pool of ``n`` samples of its model drawn once (``sample_progress(p, rng, n)``),
     resampled by the runs; the result is deterministic for a ``seed`` (``np.random.default_rng``). Vectorised over
@@ -102,6 +114,8 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     """
     budget = as_whole("budget", budget, 0, 100_000)
     n = as_whole("n", n, 1, 10_000_000)
+    if not (np.isfinite(stuck_rate) and 0.0 <= stuck_rate <= 1.0):
+        raise InputError(f"stuck_rate must lie in [0, 1], got {stuck_rate!r}")
     skills, q = [], []
     for step in steps:
         try:
@@ -135,11 +149,16 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
         end[i] = end[i + 1] if skills[i] == skills[i + 1] else i + 1
     start, end = np.append(start, m), np.append(end, m)  # step m: done, absorbing
     pool = np.vstack([pool, np.zeros((1, n))])
+    # per run and step: whether it can progress at all (stuck steps cannot); step m (done) is free
+    free = np.ones((n, m + 1), dtype=bool)
+    if stuck_rate > 0.0:
+        free[:, :m] = rng.random((n, m)) >= stuck_rate * (1.0 - np.asarray(q))
+    runs = np.arange(n)
     step = np.zeros(n, dtype=np.int64)  # each run's current step (m: done)
     acc = np.zeros(n)  # progress accumulated in the run's current stretch
     spent = np.full(n, budget, dtype=np.int64)
     for t in range(1, budget + 1):
-        acc += pool[step, rng.integers(n, size=n)]
+        acc += pool[step, rng.integers(n, size=n)] * free[runs, step]
         covered = start[step] + np.floor(acc + 1e-9).astype(np.int64)
         finished = covered >= end[step]
         step = np.where(finished, end[step], np.minimum(covered, end[step]))
@@ -151,3 +170,27 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     done = step == m
     # a run that finished on the budget's last primitive has spent == budget either way
     return Odds(p_success=float(done.mean()), expected_primitives=float(spent.mean()), budget=int(budget))
+
+
+def fit_stuck_rate(plans: Sequence[Sequence[tuple[str, float]]], reached: Sequence[bool],
+                   models: Mapping[str, OutcomeModel], budget: int = DEFAULT_BUDGET,
+                   grid: Sequence[float] = tuple(np.linspace(0.0, 1.0, 21)), seed: int = 0,
+                   n: int = 2000) -> tuple[float, dict[float, float]]:
+    """The stuck rate (:func:`mc_odds`) whose predicted ``p_success`` fits ``reached`` best: the value on ``grid``
+    with the least Brier score over the ``plans`` (each a plan's ``(skill, p)`` steps) and their outcomes.
+
+    Returns ``(rate, {rate: brier})``. Fit it on plans of training objects only, and judge it on others.
+
+    Raises:
+        InputError: no plans, or ``plans`` and ``reached`` of different lengths.
+    """
+    if len(plans) != len(reached) or not plans:
+        raise InputError(f"need as many outcomes as plans, at least one; got {len(plans)} and {len(reached)}")
+    y = np.asarray(reached, dtype=float)
+    scores = {}
+    for rate in grid:
+        p = np.array([mc_odds(steps, models, budget, seed=seed, n=n, stuck_rate=float(rate)).p_success
+                      for steps in plans])
+        scores[float(rate)] = float(np.mean((p - y) ** 2))
+    best = min(scores, key=lambda r: (scores[r], r))
+    return best, scores

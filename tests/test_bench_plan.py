@@ -112,3 +112,16 @@ def test_plan_calibration_scores_predictions_against_outcomes():
     assert cal["plans"] == 3 and cal["brier"] == pytest.approx(0.25 / 3)
     assert cal["reached"] == pytest.approx(2 / 3) and sum(b["plans"] for b in cal["bins"]) == 3
     assert plan_calibration([float("nan")], [True])["plans"] == 0
+
+
+def test_fit_stuck_fits_training_runs_only():
+    from affordplan.app.bench.plan import fit_stuck
+
+    tasks = [dict(planner="affordplan", success=bool(i % 3), steps=[["push", 0.4], ["roll", 0.3 + 0.1 * (i % 3)]])
+             for i in range(12)] + [dict(planner="greedy", success=True, steps=[])]
+    fit = fit_stuck([dict(objects="training", max_primitives=40, tasks=tasks)], grid_step=0.25)
+    assert fit["plans"] == 12 and fit["reached"] == pytest.approx(8 / 12)
+    assert set(fit["brier"]) == {0.0, 0.25, 0.5, 0.75, 1.0} and fit["brier"][fit["rate"]] == min(fit["brier"].values())
+    assert fit["rate"] > 0.0  # a third of the plans failed: retries alone would predict ~1.00 for all
+    with pytest.raises(InputError, match="training"):
+        fit_stuck([dict(objects="mixed", max_primitives=40, tasks=tasks)])

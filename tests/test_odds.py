@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from affordplan.errors import InputError
-from planner.odds import Q_FLOOR, mc_odds, plan_odds, primitives_pmf
+from planner.odds import Q_FLOOR, fit_stuck_rate, mc_odds, plan_odds, primitives_pmf
 from primitives.outcome_model import OutcomeModel
 
 
@@ -166,3 +166,51 @@ def test_mc_odds_is_quick_enough_to_rate_every_plan():
         mc_odds(steps, models, budget=60, seed=seed)
         times.append(time.perf_counter() - t0)
     assert min(times) < 0.05  # ~3 ms on one idle core; generous for a loaded machine
+
+
+# ------------------------------------------------------------------ stuck steps
+def _all_or_nothing(skills=("push", "spin", "roll")) -> dict:
+    """Outcome models whose calls achieve their whole step with probability p, else nothing."""
+    grid = np.linspace(0.0, 1.0, 1001)
+    rng = np.random.default_rng(0)
+    return {s: OutcomeModel(s, grid, (rng.random(grid.size) < grid).astype(float), k=50) for s in skills}
+
+
+def test_a_stuck_step_fails_its_run_however_large_the_budget():
+    q = [0.3, 0.8, 0.6]
+    steps = list(zip(("push", "spin", "roll"), q))
+    models = _all_or_nothing()
+    assert mc_odds(steps, models, budget=200, n=20_000, stuck_rate=0.0).p_success > 0.99
+    for rate in (0.3, 1.0):
+        expected = float(np.prod([1.0 - rate * (1.0 - qi) for qi in q]))
+        odds = mc_odds(steps, models, budget=200, n=20_000, stuck_rate=rate)
+        assert odds.p_success == pytest.approx(expected, abs=0.015)
+        assert odds.expected_primitives > mc_odds(steps, models, budget=200, n=20_000, stuck_rate=0.0).expected_primitives
+
+
+def test_certain_steps_are_never_stuck():
+    odds = mc_odds([("push", 1.0)] * 3, {"push": Constant(1.0)}, budget=10, n=500, stuck_rate=1.0)
+    assert odds.p_success == 1.0 and odds.expected_primitives == 3.0
+
+
+@pytest.mark.parametrize("rate", [-0.1, 1.5, math.nan])
+def test_a_stuck_rate_outside_zero_one_is_refused(rate):
+    with pytest.raises(InputError, match="stuck_rate"):
+        mc_odds([("push", 0.5)], {"push": Constant(1.0)}, budget=10, stuck_rate=rate)
+
+
+def test_fit_stuck_rate_recovers_the_rate_that_made_the_outcomes():
+    rng = np.random.default_rng(3)
+    models = _all_or_nothing()
+    plans, reached = [], []
+    for _ in range(160):
+        steps = [(str(rng.choice(["push", "spin", "roll"])), float(rng.uniform(0.05, 0.95)))
+                 for _ in range(int(rng.integers(1, 5)))]
+        p_true = np.prod([1.0 - 0.6 * (1.0 - q) for _, q in steps])
+        plans.append(steps)
+        reached.append(bool(rng.random() < p_true))
+    rate, scores = fit_stuck_rate(plans, reached, models, budget=80, grid=np.linspace(0, 1, 11), n=300)
+    assert 0.4 <= rate <= 0.8
+    assert scores[rate] < scores[0.0]
+    with pytest.raises(InputError):
+        fit_stuck_rate(plans, reached[:-1], models)

@@ -154,6 +154,28 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench_fit_stuck(args: argparse.Namespace) -> int:
+    from affordplan.app.bench.plan import fit_stuck
+    from affordplan.errors import InputError
+
+    reports = []
+    for path in args.files:
+        try:
+            with open(path, encoding="utf-8") as f:
+                reports.append(json.load(f))
+        except (OSError, ValueError) as exc:
+            raise InputError(f"cannot read bench results {str(path)[:120]}: {exc}") from None
+    fit = fit_stuck(reports)
+    if args.json:
+        print(json.dumps(fit, indent=2))
+        return 0
+    print(f"{fit['plans']} plans on training objects, {fit['reached']:.2f} reached; Brier of p_success by stuck rate:")
+    print("  " + ", ".join(f"{rate:.2f}: {score:.3f}" for rate, score in fit["brier"].items()))
+    print(f"best stuck rate: {fit['rate']:.2f} (Brier {fit['brier'][fit['rate']]:.3f}; "
+          f"without stuck steps {fit['brier'][0.0]:.3f})")
+    return 0
+
+
 def _cmd_affordances(args: argparse.Namespace) -> int:
     # The command line is a facade like affordplan.plan: it reaches the learned skills lazily.
     from affordplan.objects.model import load_object
@@ -479,9 +501,21 @@ def build_parser() -> argparse.ArgumentParser:
                          "(K > 0; 0, the default, is the standard run): how far outcomes move by chance alone")
     bp.add_argument("--objects", default="procedural", choices=["procedural", "household", "mixed", "training"],
                     help="the tasks' objects: the procedural test split, HACMan's 25 unseen household meshes, or "
-                         "the two by turns (default: %(default)s)")
+                         "the two by turns; training: the training objects by turns, for fitting the planner's "
+                         "stuck rate, never for reporting (default: %(default)s)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
+    bf = bench_sub.add_parser(
+        "fit-stuck", help="fit the planner's stuck rate to saved `bench plan --objects training --json` runs",
+        formatter_class=_formatter,
+        description=_wrap("Fit planner.odds.STUCK_RATE, the share of a step's predicted failure that is "
+                          "systematic (no retry succeeds), to the first plans of saved plan-bench runs on training "
+                          "objects: the rate whose predicted p_success has the least Brier score."),
+        epilog="example:\n  affordplan bench plan --objects training --sim finger --planner affordplan --seed 100 "
+               "--json > runs/train100.json\n  affordplan bench fit-stuck runs/train100.json")
+    bf.add_argument("files", nargs="+", metavar="JSON", help="bench plan --json outputs")
+    bf.add_argument("--json", action="store_true", help="print JSON instead of text")
+    bf.set_defaults(func=_cmd_bench_fit_stuck)
     _register_robustness(bench_sub)
     return parser
 

@@ -86,6 +86,8 @@ class TaskResult:
 class BenchReport:
     results: list[TaskResult] = field(default_factory=list)
     draw: int = 0  # which draw of the run's random numbers (bench_plan's ``draw``)
+    objects: str = "procedural"  # the tasks' objects (OBJECT_SETS)
+    max_primitives: int = 40  # each execution's budget
 
     def summary(self, planner: str) -> dict:
         rs = [r for r in self.results if r.planner == planner]
@@ -138,7 +140,8 @@ class BenchReport:
 
     def as_dict(self) -> dict:
         names = list(dict.fromkeys(r.planner for r in self.results))
-        return dict(versions=versions(), draw=self.draw, summary=[self.summary(n) for n in names],
+        return dict(versions=versions(), draw=self.draw, objects=self.objects, max_primitives=self.max_primitives,
+                    summary=[self.summary(n) for n in names],
                     tasks=[asdict(r) for r in self.results])
 
 
@@ -301,7 +304,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
         raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
     skills = None if weights_dir is None else load_skills(weights_dir)
     rng = np.random.default_rng(seed)
-    report = BenchReport(draw=draw)
+    report = BenchReport(draw=draw, objects=objects, max_primitives=max_primitives)
     bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")
     for i in range(max(wanted) + 1):
         # drawn in order: task i is the same in any run
@@ -319,3 +322,38 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
         bar.update(1)
     bar.close()
     return report
+
+
+def fit_stuck(reports: Sequence[dict], grid_step: float = 0.05, seed: int = 0) -> dict:
+    """Fit :data:`planner.odds.STUCK_RATE` to the affordplan plans of saved bench runs (``BenchReport.as_dict``, as
+    ``affordplan bench plan --objects training --json`` prints it): the rate whose first-plan ``p_success``
+    (:func:`planner.odds.mc_odds` through the shipped outcome models, each run's execution budget) has the least
+    Brier score against whether the goal was reached.
+
+    Returns ``dict(rate, plans, reached, brier={rate: score})``.
+
+    Raises:
+        InputError: a run on objects other than the training ones (held-out objects are never fitted on), or no
+            affordplan plans with their steps.
+    """
+    from planner.odds import fit_stuck_rate
+    from primitives.outcome_model import OutcomeModel
+
+    plans, reached, budgets = [], [], set()
+    for report in reports:
+        if report.get("objects") != "training":
+            raise InputError(f"the stuck rate is fitted on --objects training runs only, got a run on "
+                             f"{str(report.get('objects'))[:40]!r}")
+        budgets.add(int(report["max_primitives"]))
+        for task in report["tasks"]:
+            if task["planner"] == "affordplan" and task.get("steps"):
+                plans.append([(skill, float(p)) for skill, p in task["steps"]])
+                reached.append(bool(task["success"]))
+    if not plans:
+        raise InputError("no affordplan plans with steps in these runs")
+    if len(budgets) != 1:
+        raise InputError(f"the runs used different execution budgets: {sorted(budgets)}")
+    models = {name: OutcomeModel.load(name) for name in {skill for steps in plans for skill, _ in steps}}
+    grid = np.round(np.arange(0.0, 1.0 + 1e-9, grid_step), 6)
+    rate, scores = fit_stuck_rate(plans, reached, models, budget=budgets.pop(), grid=grid, seed=seed)
+    return dict(rate=rate, plans=len(plans), reached=float(np.mean(reached)), brier=scores)
