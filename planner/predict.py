@@ -13,6 +13,7 @@ state at the same place on the table.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -118,13 +119,24 @@ class Predictor:
 
     def p_success_many(self, queries: list[tuple[str, dict | None, np.ndarray]]) -> np.ndarray:
         """Batched :meth:`p_success` (one network pass per skill)."""
+        out = self._ask(queries, lambda skill, obs, parameterised: skill.success_probability_obs(obs, parameterised))
+        self.queries += len(queries)
+        return out
+
+    def spread_many(self, queries: list[tuple[str, dict | None, np.ndarray]]) -> np.ndarray:
+        """The success models' member disagreement on each of :meth:`p_success_many`'s queries
+        (:meth:`primitives.skills.Skill.success_spread_obs`): how uncertain each rating is."""
+        return self._ask(queries, lambda skill, obs, parameterised: skill.success_spread_obs(obs, parameterised))
+
+    def _ask(self, queries: list[tuple[str, dict | None, np.ndarray]],
+             answer: Callable[[Skill, np.ndarray, bool], np.ndarray]) -> np.ndarray:
+        """``answer(skill, observations, parameterised)`` for the queries, batched per skill and parameterisation."""
         out = np.zeros(len(queries))
         for skill in SKILLS:
             for parameterised in (True, False):
                 idx = [i for i, q in enumerate(queries) if q[0] == skill and (q[1] is not None) == parameterised]
                 if idx:
                     obs = np.stack([self.observation(*queries[i]) for i in idx])
-                    out[idx] = self.skills[skill].success_probability_obs(obs, parameterised)
-        self.queries += len(queries)
+                    out[idx] = answer(self.skills[skill], obs, parameterised)
         return out
 

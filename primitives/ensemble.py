@@ -50,6 +50,18 @@ class StackedEnsemble:
     def __call__(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
         """Calibrated probability of success ``(B,)`` from observations ``(B, N, 9)`` (goal frame, metres) and
         decision features ``(B, >= n_decision)`` (:func:`primitives.training.success.decision_features`)."""
+        logit = self.member_logits(obs, decision).mean(dim=0)  # the members' mean logit, as SuccessNet.logit
+        return torch.sigmoid(self.platt[0] * logit + self.platt[1])
+
+    @torch.no_grad()
+    def member_probabilities(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+        """Each member's probability of success ``(M, B)``, through the ensemble's Platt scaling: where the members
+        disagree, the data they were fitted on did not settle the answer (a deep ensemble's uncertainty)."""
+        return torch.sigmoid(self.platt[0] * self.member_logits(obs, decision) + self.platt[1])
+
+    @torch.no_grad()
+    def member_logits(self, obs: torch.Tensor, decision: torch.Tensor) -> torch.Tensor:
+        """Each member's logit ``(M, B)`` (arguments as :meth:`__call__`)."""
         if obs.ndim != 3 or decision.ndim != 2 or decision.shape[0] != obs.shape[0] \
                 or decision.shape[1] < self.n_decision:
             raise InputError(f"expected observations (B, N, 9) and decision features (B, >= {self.n_decision}), "
@@ -65,5 +77,4 @@ class StackedEnsemble:
             z = torch.baddbmm(bias, z, weight)
             if k < len(head) - 1:
                 z = z.relu_()
-        logit = z.squeeze(-1).mean(dim=0)  # the members' mean logit, as SuccessNet.logit
-        return torch.sigmoid(self.platt[0] * logit + self.platt[1])
+        return z.squeeze(-1)

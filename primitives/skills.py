@@ -170,6 +170,14 @@ class Skill:
         return self.frame_search.calibrate(p.reshape(*obs.shape[:-2], len(frames)).max(axis=-1), parameterised)
 
 
+    def success_spread_obs(self, obs: np.ndarray, parameterised: bool = True) -> np.ndarray:
+        """How much the success model's members disagree on the ratings :meth:`success_probability_obs` gives
+        (:meth:`primitives.success_model.SuccessModel.spread`): the searched success model's where the skill has
+        one, else the goal-frame model's on the goal frame. A planner can read it as the rating's uncertainty."""
+        model = self.searched_model if self.searched_model is not None else self.success_model
+        return model.spread(obs)
+
+
 def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
                success_weights: str | os.PathLike | None = None,
                frame_search: FrameSearch | bool = True, searched: bool = True,

@@ -171,6 +171,18 @@ class SuccessModel:
         p = self._stacked(x, d).numpy()
         return p[0] if single else p
 
+    @torch.no_grad()
+    def spread(self, obs: np.ndarray) -> np.ndarray:
+        """The members' disagreement on P(success) for observations ``(N, 9)`` or ``(B, N, 9)``: the standard
+        deviation of their calibrated probabilities (0 for a one-member net). Low on observations like those the
+        model was fitted on, higher where they did not settle the answer; it is not itself a probability."""
+        x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
+        single = x.ndim == 2
+        x = x[None] if single else x
+        _, _, d = decision_features(self.policy, x)
+        s = self._stacked.member_probabilities(x, d).std(dim=0, correction=0).numpy()
+        return s[0] if single else s
+
 
 def load_success_net(skill: str, path: str | os.PathLike | None = None) -> SuccessNet:
     """A success net from ``path`` or the shipped ``weights/{skill}_success.pt``.

@@ -56,3 +56,20 @@ def test_the_shipped_models_answer_as_their_nets():
             expected = model.net(obs, decision).numpy()
         assert np.allclose(model.predict(obs.numpy()), expected, atol=1e-6, rtol=0)
 
+
+
+def test_member_probabilities_are_the_members_through_the_ensembles_scaling():
+    """The ensemble's answer is sigmoid(a * mean member logit + b); each member's probability is sigmoid(a * its
+    logit + b), so undoing the scaling and averaging gives the ensemble's answer back. One member never disagrees."""
+    torch.manual_seed(0)
+    net = success.SuccessNet(members=4).eval()
+    net.platt[:] = torch.tensor([0.8, -0.3])
+    stacked = StackedEnsemble(net)
+    obs, dec = torch.randn(5, 32, 9), torch.randn(5, 14)
+    members = stacked.member_probabilities(obs, dec).double()
+    assert members.shape == (4, 5)
+    member_logits = (torch.logit(members) + 0.3) / 0.8
+    assert torch.allclose(torch.sigmoid(0.8 * member_logits.mean(0) - 0.3), stacked(obs, dec).double(), atol=1e-5)
+    assert members.std(dim=0).min() > 0  # four independently initialised members disagree
+    one = StackedEnsemble(success.SuccessNet(members=1).eval())
+    assert torch.all(one.member_probabilities(obs, dec).std(dim=0, correction=0) == 0)

@@ -24,3 +24,22 @@ def test_a_predictor_loads_a_weights_folder_or_takes_skills_not_both(cube):
     assert Predictor(cube).skills["push"].success_model.net.n_decision == 14
     with pytest.raises(InputError, match="not both"):
         Predictor(cube, skills=predictor.skills, weights_dir=kept)
+
+
+def test_each_rating_comes_with_its_members_disagreement(cube):
+    """spread_many answers query by query, as p_success_many does: the same query gives the same spread wherever
+    it stands in a batch, and the shipped five-member models disagree a little (0 < spread < 0.5)."""
+    import numpy as np
+
+    from planner.predict import Predictor
+
+    predictor = Predictor(cube, seed=0)
+    T = cube.resting_states[0].pose((0.5, 0.0), 0.3)
+    queries = [("push", {"direction": 0.4}, T), ("spin", {"angle": 0.8}, T), ("roll", None, T),
+               ("push", None, T)]
+    spread = predictor.spread_many(queries)
+    p = predictor.p_success_many(queries)
+    assert spread.shape == p.shape == (4,) and np.all(np.isfinite(spread))
+    assert np.all((spread > 0) & (spread < 0.5))
+    again = predictor.spread_many(queries[::-1])[::-1]
+    assert np.allclose(again, spread, atol=1e-6)
