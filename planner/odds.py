@@ -22,9 +22,10 @@ asked effect, given the step's strict probability) and counts the primitives unt
 **Stuck steps.** Retries are not independent: a roll that fails on this object because the fingertip cannot get under
 it fails again, and a push against a clamp stays clamped. Treating every try as a fresh draw makes a long budget look
 like certain success (0.23's plans all predicted 1.00 and reached 0.83). :func:`mc_odds` therefore lets each step of a
-run be *stuck* with probability ``stuck_rate * (1 - q)`` (``q``: the step's predicted success of one try): a stuck
-step makes no progress however often it is tried. ``stuck_rate`` is one number, fitted to plan outcomes on training
-objects (:data:`STUCK_RATE`, :func:`fit_stuck_rate`).
+run be *stuck* with probability ``r[skill] * (1 - q)`` (``q``: the step's predicted success of one try): a stuck
+step makes no progress however often it is tried. The rates ``r``, one per skill, are fitted to plan outcomes on
+training objects (:data:`STUCK_RATES`, :func:`fit_stuck_rates`). Stuck draws are independent of progress draws, so
+``p_success`` is the product of the stuck-free odds and every step's ``1 - r * (1 - q)``.
 """
 
 from __future__ import annotations
@@ -43,10 +44,10 @@ if TYPE_CHECKING:
 
 DEFAULT_BUDGET = 60  # primitives: Plan.execute's default max_primitives
 Q_FLOOR = 0.02  # a step rated below this is treated as this: the executor replaces a step that keeps failing
-# P(a step is stuck in a run) = STUCK_RATE * (1 - q). Fitted by fit_stuck_rate to the first plans of
-# `affordplan bench plan --objects training --fit-stuck` (training objects only; the command and the figures:
-# docs/guide.md, "A plan's odds").
-STUCK_RATE = 0.0
+# P(a step of skill k is stuck in a run) = STUCK_RATES[k] * (1 - q). Fitted by fit_stuck_rates to the first plans of
+# `affordplan bench plan --objects training` runs (`affordplan bench fit-stuck`; training objects only; the
+# commands and the figures: docs/guide.md, "What a plan predicts").
+STUCK_RATES: dict[str, float] = {"push": 0.0, "roll": 0.0, "spin": 0.0}
 
 
 @dataclass(frozen=True)
@@ -89,7 +90,7 @@ def plan_odds(step_probabilities: Sequence[float], budget: int = DEFAULT_BUDGET)
 
 
 def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeModel], budget: int = DEFAULT_BUDGET,
-            seed: int = 0, n: int = 2000, stuck_rate: float = STUCK_RATE) -> Odds:
+            seed: int = 0, n: int = 2000, stuck_rate: float | Mapping[str, float] | None = None) -> Odds:
     """The :class:`Odds` of a plan by Monte Carlo through the skills' outcome models.
 
     ``steps``: the plan's ``(skill, strict p)`` in order; ``models``: an outcome model per skill used, anything with
@@ -102,7 +103,8 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     covers 1.4 push steps) but not across a change of skill; a roll counts only when it reached its state (a
     progress of at least 1 counts 1, less counts 0). ``p_success`` is the share of runs done within ``budget``
     primitives, ``expected_primitives`` their mean, counting a run that is not done as ``budget``. In each run, each
-    step is stuck (makes no progress at all) with probability ``stuck_rate * (1 - p)`` (the module docstring).
+    step is stuck (makes no progress at all) with probability ``r * (1 - p)``, ``r`` its skill's entry of
+    ``stuck_rate`` (a number: the same for every skill; ``None``: :data:`STUCK_RATES`; the module docstring).
 
     Each step's draws come from a pool of ``n`` samples of its model drawn once (``sample_progress(p, rng, n)``),
     resampled by the runs; the result is deterministic for a ``seed`` (``np.random.default_rng``). Vectorised over
@@ -114,8 +116,7 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     """
     budget = as_whole("budget", budget, 0, 100_000)
     n = as_whole("n", n, 1, 10_000_000)
-    if not (np.isfinite(stuck_rate) and 0.0 <= stuck_rate <= 1.0):
-        raise InputError(f"stuck_rate must lie in [0, 1], got {stuck_rate!r}")
+    rates = _stuck_rates(stuck_rate)
     skills, q = [], []
     for step in steps:
         try:
@@ -151,8 +152,9 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     pool = np.vstack([pool, np.zeros((1, n))])
     # per run and step: whether it can progress at all (stuck steps cannot); step m (done) is free
     free = np.ones((n, m + 1), dtype=bool)
-    if stuck_rate > 0.0:
-        free[:, :m] = rng.random((n, m)) >= stuck_rate * (1.0 - np.asarray(q))
+    stuck = np.array([rates.get(skill, 0.0) for skill in skills]) * (1.0 - np.asarray(q))
+    if np.any(stuck > 0.0):
+        free[:, :m] = rng.random((n, m)) >= stuck
     runs = np.arange(n)
     step = np.zeros(n, dtype=np.int64)  # each run's current step (m: done)
     acc = np.zeros(n)  # progress accumulated in the run's current stretch
@@ -172,14 +174,28 @@ def mc_odds(steps: Sequence[tuple[str, float]], models: Mapping[str, OutcomeMode
     return Odds(p_success=float(done.mean()), expected_primitives=float(spent.mean()), budget=int(budget))
 
 
-def fit_stuck_rate(plans: Sequence[Sequence[tuple[str, float]]], reached: Sequence[bool],
-                   models: Mapping[str, OutcomeModel], budget: int = DEFAULT_BUDGET,
-                   grid: Sequence[float] = tuple(np.linspace(0.0, 1.0, 21)), seed: int = 0,
-                   n: int = 2000) -> tuple[float, dict[float, float]]:
-    """The stuck rate (:func:`mc_odds`) whose predicted ``p_success`` fits ``reached`` best: the value on ``grid``
-    with the least Brier score over the ``plans`` (each a plan's ``(skill, p)`` steps) and their outcomes.
+def _stuck_rates(stuck_rate: float | Mapping[str, float] | None) -> dict[str, float]:
+    """``stuck_rate`` as a rate per skill (:func:`mc_odds`), checked."""
+    if stuck_rate is None:
+        return dict(STUCK_RATES)
+    rates = dict(stuck_rate) if isinstance(stuck_rate, Mapping) else {skill: stuck_rate for skill in STUCK_RATES}
+    for skill, rate in rates.items():
+        if not (isinstance(rate, (int, float, np.floating)) and np.isfinite(rate) and 0.0 <= rate <= 1.0):
+            raise InputError(f"stuck_rate must lie in [0, 1], got {rate!r} for {skill!r}")
+    return {skill: float(rate) for skill, rate in rates.items()}
 
-    Returns ``(rate, {rate: brier})``. Fit it on plans of training objects only, and judge it on others.
+
+def fit_stuck_rates(plans: Sequence[Sequence[tuple[str, float]]], reached: Sequence[bool],
+                    models: Mapping[str, OutcomeModel], budget: int = DEFAULT_BUDGET,
+                    grid: Sequence[float] = tuple(np.linspace(0.0, 1.0, 21)), seed: int = 0,
+                    n: int = 2000) -> tuple[dict[str, float], float, float]:
+    """The stuck rates (one per skill, :func:`mc_odds`) whose predicted ``p_success`` fits ``reached`` best: the
+    rates on ``grid`` (every combination for the skills the plans use) with the least Brier score over the
+    ``plans`` (each a plan's ``(skill, p)`` steps) and their outcomes.
+
+    Each plan's stuck-free odds are simulated once; the stuck steps then multiply them (module docstring).
+    Returns ``(rates, brier, brier_without)``: the rates, their Brier score, and the score with no stuck steps.
+    Fit on plans of training objects only, and judge the rates on others.
 
     Raises:
         InputError: no plans, or ``plans`` and ``reached`` of different lengths.
@@ -187,10 +203,17 @@ def fit_stuck_rate(plans: Sequence[Sequence[tuple[str, float]]], reached: Sequen
     if len(plans) != len(reached) or not plans:
         raise InputError(f"need as many outcomes as plans, at least one; got {len(plans)} and {len(reached)}")
     y = np.asarray(reached, dtype=float)
-    scores = {}
-    for rate in grid:
-        p = np.array([mc_odds(steps, models, budget, seed=seed, n=n, stuck_rate=float(rate)).p_success
-                      for steps in plans])
-        scores[float(rate)] = float(np.mean((p - y) ** 2))
-    best = min(scores, key=lambda r: (scores[r], r))
-    return best, scores
+    base = np.array([mc_odds(steps, models, budget, seed=seed, n=n, stuck_rate=0.0).p_success for steps in plans])
+    used = sorted({skill for steps in plans for skill, _ in steps})
+    # per plan and skill, every step's (1 - q): the stuck factor is prod over steps of 1 - r[skill] * (1 - q)
+    misses = [{skill: np.array([1.0 - q for k, q in steps if k == skill]) for skill in used} for steps in plans]
+    grid = np.asarray(grid, dtype=float)
+    best, best_score = None, np.inf
+    for combo in np.array(np.meshgrid(*[grid] * len(used), indexing="ij")).reshape(len(used), -1).T:
+        p = base * np.array([np.prod([np.prod(1.0 - r * miss[skill]) for skill, r in zip(used, combo)])
+                             for miss in misses])
+        score = float(np.mean((p - y) ** 2))
+        if score < best_score - 1e-12:
+            best, best_score = combo, score
+    rates = {skill: 0.0 for skill in STUCK_RATES} | {skill: float(r) for skill, r in zip(used, best)}
+    return rates, best_score, float(np.mean((base - y) ** 2))

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from affordplan.errors import InputError
-from planner.odds import Q_FLOOR, fit_stuck_rate, mc_odds, plan_odds, primitives_pmf
+from planner.odds import Q_FLOOR, fit_stuck_rates, mc_odds, plan_odds, primitives_pmf
 from primitives.outcome_model import OutcomeModel
 
 
@@ -200,18 +200,26 @@ def test_a_stuck_rate_outside_zero_one_is_refused(rate):
         mc_odds([("push", 0.5)], {"push": Constant(1.0)}, budget=10, stuck_rate=rate)
 
 
-def test_fit_stuck_rate_recovers_the_rate_that_made_the_outcomes():
+def test_fit_stuck_rates_recovers_the_rates_that_made_the_outcomes():
     rng = np.random.default_rng(3)
     models = _all_or_nothing()
+    truth = {"push": 0.1, "roll": 0.9, "spin": 0.0}
     plans, reached = [], []
-    for _ in range(160):
+    for _ in range(300):
         steps = [(str(rng.choice(["push", "spin", "roll"])), float(rng.uniform(0.05, 0.95)))
                  for _ in range(int(rng.integers(1, 5)))]
-        p_true = np.prod([1.0 - 0.6 * (1.0 - q) for _, q in steps])
         plans.append(steps)
-        reached.append(bool(rng.random() < p_true))
-    rate, scores = fit_stuck_rate(plans, reached, models, budget=80, grid=np.linspace(0, 1, 11), n=300)
-    assert 0.4 <= rate <= 0.8
-    assert scores[rate] < scores[0.0]
+        reached.append(bool(rng.random() < np.prod([1.0 - truth[k] * (1.0 - q) for k, q in steps])))
+    rates, brier, without = fit_stuck_rates(plans, reached, models, budget=80, grid=np.linspace(0, 1, 11), n=300)
+    assert set(rates) == {"push", "roll", "spin"}
+    assert rates["roll"] >= 0.6 and rates["push"] <= 0.3 and rates["spin"] <= 0.3
+    assert brier < without
     with pytest.raises(InputError):
-        fit_stuck_rate(plans, reached[:-1], models)
+        fit_stuck_rates(plans, reached[:-1], models)
+
+
+def test_a_rate_per_skill_applies_to_that_skills_steps_only():
+    models = _all_or_nothing()
+    steps = [("push", 0.5), ("roll", 0.5)]
+    only_roll = mc_odds(steps, models, budget=200, n=20_000, stuck_rate={"push": 0.0, "roll": 1.0, "spin": 1.0})
+    assert only_roll.p_success == pytest.approx(0.5, abs=0.015)

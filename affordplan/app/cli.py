@@ -158,21 +158,27 @@ def _cmd_bench_fit_stuck(args: argparse.Namespace) -> int:
     from affordplan.app.bench.plan import fit_stuck
     from affordplan.errors import InputError
 
-    reports = []
-    for path in args.files:
-        try:
-            with open(path, encoding="utf-8") as f:
-                reports.append(json.load(f))
-        except (OSError, ValueError) as exc:
-            raise InputError(f"cannot read bench results {str(path)[:120]}: {exc}") from None
-    fit = fit_stuck(reports)
+    def read(paths: list[str]) -> list[dict]:
+        reports = []
+        for path in paths:
+            try:
+                with open(path, encoding="utf-8") as f:
+                    reports.append(json.load(f))
+            except (OSError, ValueError) as exc:
+                raise InputError(f"cannot read bench results {str(path)[:120]}: {exc}") from None
+        return reports
+
+    fit = fit_stuck(read(args.files), held_out=read(args.held_out or []))
     if args.json:
         print(json.dumps(fit, indent=2))
         return 0
-    print(f"{fit['plans']} plans on training objects, {fit['reached']:.2f} reached; Brier of p_success by stuck rate:")
-    print("  " + ", ".join(f"{rate:.2f}: {score:.3f}" for rate, score in fit["brier"].items()))
-    print(f"best stuck rate: {fit['rate']:.2f} (Brier {fit['brier'][fit['rate']]:.3f}; "
-          f"without stuck steps {fit['brier'][0.0]:.3f})")
+    rates = ", ".join(f"{skill} {rate:.1f}" for skill, rate in fit["rates"].items())
+    print(f"fitted on {fit['plans']} plans on training objects ({fit['reached']:.2f} reached): stuck rates {rates}; "
+          f"Brier of p_success {fit['brier']:.3f} (without stuck steps {fit['brier_without']:.3f})")
+    if "held_out" in fit:
+        h = fit["held_out"]
+        print(f"held out, {h['plans']} plans ({h['reached']:.2f} reached): Brier {h['brier']:.3f} "
+              f"(without stuck steps {h['brier_without']:.3f})")
     return 0
 
 
@@ -508,12 +514,14 @@ def build_parser() -> argparse.ArgumentParser:
     bf = bench_sub.add_parser(
         "fit-stuck", help="fit the planner's stuck rate to saved `bench plan --objects training --json` runs",
         formatter_class=_formatter,
-        description=_wrap("Fit planner.odds.STUCK_RATE, the share of a step's predicted failure that is "
-                          "systematic (no retry succeeds), to the first plans of saved plan-bench runs on training "
+        description=_wrap("Fit planner.odds.STUCK_RATES, per skill the share of a step's predicted failure "
+                          "that is systematic (no retry succeeds), to the first plans of saved plan-bench runs on training "
                           "objects: the rate whose predicted p_success has the least Brier score."),
         epilog="example:\n  affordplan bench plan --objects training --sim finger --planner affordplan --seed 100 "
-               "--json > runs/train100.json\n  affordplan bench fit-stuck runs/train100.json")
+               "--json > runs/train100.json\n  affordplan bench fit-stuck runs/train100.json --held-out runs/train101.json")
     bf.add_argument("files", nargs="+", metavar="JSON", help="bench plan --json outputs")
+    bf.add_argument("--held-out", nargs="+", metavar="JSON", default=None,
+                    help="other training-object runs, scored with the fitted rates")
     bf.add_argument("--json", action="store_true", help="print JSON instead of text")
     bf.set_defaults(func=_cmd_bench_fit_stuck)
     _register_robustness(bench_sub)

@@ -29,6 +29,7 @@ from affordplan.errors import AffordplanError, InputError
 from affordplan.goal import Goal
 from affordplan.objects import housekeep
 from affordplan.objects.model import ObjectModel, load_object, random_object
+from affordplan.robot import SKILLS
 from affordplan.world import Box, Workspace
 from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, inflated_footprints, make_checkers
@@ -324,25 +325,13 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     return report
 
 
-def fit_stuck(reports: Sequence[dict], grid_step: float = 0.05, seed: int = 0) -> dict:
-    """Fit :data:`planner.odds.STUCK_RATE` to the affordplan plans of saved bench runs (``BenchReport.as_dict``, as
-    ``affordplan bench plan --objects training --json`` prints it): the rate whose first-plan ``p_success``
-    (:func:`planner.odds.mc_odds` through the shipped outcome models, each run's execution budget) has the least
-    Brier score against whether the goal was reached.
-
-    Returns ``dict(rate, plans, reached, brier={rate: score})``.
-
-    Raises:
-        InputError: a run on objects other than the training ones (held-out objects are never fitted on), or no
-            affordplan plans with their steps.
-    """
-    from planner.odds import fit_stuck_rate
-    from primitives.outcome_model import OutcomeModel
-
+def _training_plans(reports: Sequence[dict]) -> tuple[list[list[tuple[str, float]]], list[bool], int]:
+    """The affordplan first plans' steps, whether each reached, and the runs' execution budget, from saved bench
+    runs on training objects."""
     plans, reached, budgets = [], [], set()
     for report in reports:
         if report.get("objects") != "training":
-            raise InputError(f"the stuck rate is fitted on --objects training runs only, got a run on "
+            raise InputError(f"the stuck rates are fitted on --objects training runs only, got a run on "
                              f"{str(report.get('objects'))[:40]!r}")
         budgets.add(int(report["max_primitives"]))
         for task in report["tasks"]:
@@ -353,7 +342,35 @@ def fit_stuck(reports: Sequence[dict], grid_step: float = 0.05, seed: int = 0) -
         raise InputError("no affordplan plans with steps in these runs")
     if len(budgets) != 1:
         raise InputError(f"the runs used different execution budgets: {sorted(budgets)}")
-    models = {name: OutcomeModel.load(name) for name in {skill for steps in plans for skill, _ in steps}}
+    return plans, reached, budgets.pop()
+
+
+def fit_stuck(reports: Sequence[dict], held_out: Sequence[dict] = (), grid_step: float = 0.1, seed: int = 0) -> dict:
+    """Fit :data:`planner.odds.STUCK_RATES` to the affordplan plans of saved bench runs (``BenchReport.as_dict``, as
+    ``affordplan bench plan --objects training --json`` prints it): the rates whose first-plan ``p_success``
+    (:func:`planner.odds.mc_odds` through the shipped outcome models, the runs' execution budget) has the least
+    Brier score against whether the goal was reached (:func:`planner.odds.fit_stuck_rates`). ``held_out``: other
+    training runs, scored with the fitted rates and without stuck steps.
+
+    Returns ``dict(rates, plans, reached, brier, brier_without)``, with ``held_out=dict(plans, reached, brier,
+    brier_without)`` when given.
+
+    Raises:
+        InputError: a run on objects other than the training ones (held-out objects are never fitted on), or no
+            affordplan plans with their steps.
+    """
+    from planner.odds import fit_stuck_rates, mc_odds
+    from primitives.outcome_model import OutcomeModel
+
+    plans, reached, budget = _training_plans(reports)
+    models = {name: OutcomeModel.load(name) for name in SKILLS}
     grid = np.round(np.arange(0.0, 1.0 + 1e-9, grid_step), 6)
-    rate, scores = fit_stuck_rate(plans, reached, models, budget=budgets.pop(), grid=grid, seed=seed)
-    return dict(rate=rate, plans=len(plans), reached=float(np.mean(reached)), brier=scores)
+    rates, brier, without = fit_stuck_rates(plans, reached, models, budget=budget, grid=grid, seed=seed)
+    fit = dict(rates=rates, plans=len(plans), reached=float(np.mean(reached)), brier=brier, brier_without=without)
+    if held_out:
+        plans, reached, budget = _training_plans(held_out)
+        y = np.asarray(reached, dtype=float)
+        scores = [float(np.mean((np.array([mc_odds(steps, models, budget, seed=seed, stuck_rate=r).p_success
+                                           for steps in plans]) - y) ** 2)) for r in (rates, 0.0)]
+        fit["held_out"] = dict(plans=len(plans), reached=float(y.mean()), brier=scores[0], brier_without=scores[1])
+    return fit
