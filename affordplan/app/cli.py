@@ -512,13 +512,14 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     bf = bench_sub.add_parser(
-        "fit-stuck", help="fit the planner's stuck rate to saved `bench plan --objects training --json` runs",
+        "fit-stuck", help="fit the planner's stuck rates to saved `bench plan --objects training --json` runs",
         formatter_class=_formatter,
         description=_wrap("Fit planner.odds.STUCK_RATES, per skill the share of a step's predicted failure "
-                          "that is systematic (no retry succeeds), to the first plans of saved plan-bench runs on training "
-                          "objects: the rate whose predicted p_success has the least Brier score."),
+                          "that is systematic (no retry succeeds), to the first plans of saved plan-bench runs on "
+                          "training objects: the rates whose predicted p_success has the least Brier score."),
         epilog="example:\n  affordplan bench plan --objects training --sim finger --planner affordplan --seed 100 "
-               "--json > runs/train100.json\n  affordplan bench fit-stuck runs/train100.json --held-out runs/train101.json")
+               "--json > runs/train100.json\n"
+               "  affordplan bench fit-stuck runs/train100.json --held-out runs/train101.json")
     bf.add_argument("files", nargs="+", metavar="JSON", help="bench plan --json outputs")
     bf.add_argument("--held-out", nargs="+", metavar="JSON", default=None,
                     help="other training-object runs, scored with the fitted rates")
