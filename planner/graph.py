@@ -10,11 +10,11 @@ down-weighted (:meth:`RestingStateGraph.penalise`), so the next route goes anoth
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import networkx as nx
 
-from affordplan.errors import PlanningError
+from affordplan.errors import InputError, PlanningError
 from affordplan.objects.model import ObjectModel
 from primitives.params import roll_targets
 
@@ -32,18 +32,27 @@ class RestingStateGraph:
 
     Args:
         obj: the object.
-        roll_probability: ``(i, j) -> P(a roll from state i ends in state j)``.
+        roll_probability: ``(i, j) -> P(a roll from state i ends in state j)``, asked edge by edge.
+        rate_edges: instead, ``[(i, j), ...] -> [P, ...]``, asked once for every edge (one batched query of the
+            success model rather than one per edge: a many-faced object has dozens).
+
+    Raises:
+        InputError: neither or both of ``roll_probability`` and ``rate_edges``.
     """
 
-    def __init__(self, obj: ObjectModel, roll_probability: Callable[[int, int], float]):
+    def __init__(self, obj: ObjectModel, roll_probability: Callable[[int, int], float] | None = None, *,
+                 rate_edges: Callable[[list[tuple[int, int]]], Sequence[float]] | None = None):
+        if (roll_probability is None) == (rate_edges is None):
+            raise InputError("give roll_probability or rate_edges, one of them")
         self.obj = obj
         self.graph = nx.DiGraph()
         for s in obj.resting_states:
             self.graph.add_node(s.index, probability=s.probability)
-        for s in obj.resting_states:
-            for t in roll_targets(obj, s.index):
-                p = min(MAX_PROBABILITY, max(MIN_PROBABILITY, float(roll_probability(s.index, t))))
-                self.graph.add_edge(s.index, t, p=p, weight=-math.log(p))
+        edges = [(s.index, t) for s in obj.resting_states for t in roll_targets(obj, s.index)]
+        rates = rate_edges(edges) if rate_edges is not None else [roll_probability(i, j) for i, j in edges]
+        for (i, j), p in zip(edges, rates, strict=True):
+            p = min(MAX_PROBABILITY, max(MIN_PROBABILITY, float(p)))
+            self.graph.add_edge(i, j, p=p, weight=-math.log(p))
 
     def probability(self, i: int, j: int) -> float:
         return float(self.graph.edges[i, j]["p"])

@@ -224,7 +224,7 @@ class Planner:
         self._standoff = Protocol().standoff
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace, reach)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
-        self.graph = RestingStateGraph(obj, self._roll_probability)
+        self.graph = RestingStateGraph(obj, rate_edges=self._roll_probabilities)
         self.budget = DEFAULT_BUDGET  # primitives a plan's odds are rated within (planner.odds)
         self._calls = 0
 
@@ -249,9 +249,11 @@ class Planner:
         return plan_odds([s.p_success for s in steps], budget)
 
     # ------------------------------------------------------------------ queries
-    def _roll_probability(self, i: int, j: int) -> float:
+    def _roll_probabilities(self, edges: list[tuple[int, int]]) -> np.ndarray:
+        """P(roll i -> j) for each edge, at the workspace centre with yaw 0 (one batched query)."""
         x, y = self.workspace.center
-        return self.predictor.p_success("roll", {"target": j}, state_pose(self.obj, i, x, y, 0.0))
+        return self.predictor.p_success_many([("roll", {"target": j}, state_pose(self.obj, i, x, y, 0.0))
+                                              for i, j in edges])
 
     def record_failure(self, skill: str, params: dict, T_world_object: np.ndarray) -> int:
         """Remember a failed call; returns how often that (state, skill, parameter) has failed."""

@@ -30,3 +30,23 @@ def test_graph_takes_the_fewest_rolls_when_the_model_rates_them_all_near_certain
     graph = RestingStateGraph(cube, lambda i, j: 0.988 if (i, j) == (0, direct) else 0.996)
     assert graph.route(0, direct) == [0, direct]
     assert graph.probability(0, direct) == MAX_PROBABILITY
+
+
+def test_edges_rated_in_one_batch_match_edges_rated_one_by_one():
+    from affordplan.errors import InputError
+
+    cube = ap.load_object("cube")
+    rate = lambda i, j: 0.1 + 0.8 * ((3 * i + j) % 7) / 7  # noqa: E731
+    asked = []
+
+    def rate_edges(edges):
+        asked.append(len(edges))
+        return [rate(i, j) for i, j in edges]
+
+    one_by_one, batched = RestingStateGraph(cube, rate), RestingStateGraph(cube, rate_edges=rate_edges)
+    assert asked == [one_by_one.graph.number_of_edges()]  # a single call for every edge
+    assert dict(one_by_one.graph.edges) == dict(batched.graph.edges)
+    with pytest.raises(InputError):
+        RestingStateGraph(cube)
+    with pytest.raises(InputError):
+        RestingStateGraph(cube, rate, rate_edges=rate_edges)
