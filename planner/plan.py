@@ -47,6 +47,7 @@ from affordplan.world import Box, Workspace
 from planner import chain
 from planner.footprint import footprint, inflate, place
 from planner.graph import RestingStateGraph
+from planner.memory import FAILURES_TO_AVOID, FailureMemory
 from planner.motion import FootprintChecker, plan_path
 from planner.odds import DEFAULT_BUDGET, Odds, mc_odds, plan_odds
 from planner.predict import Predictor, expected_pose, state_pose
@@ -56,7 +57,6 @@ if TYPE_CHECKING:  # planner.execute imports this module's Planner; Plan.execute
     from affordplan.sim.simulator import Simulator
     from planner.execute import Execution
 
-FAILURES_TO_AVOID = 2  # a (state, skill, parameter) that failed this often is avoided
 SPLIT_ANGLE = math.radians(35.0)
 # Turns tried, in order, on each side of a push that failed twice (the first is SPLIT_ANGLE): each detour
 # push must itself not have failed twice, or the plan would repeat a failure under another name.
@@ -71,11 +71,6 @@ TURN_BEFORE_MARGIN = 0.15
 # it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
 # rolls back (when the two rolls and a spin there are likelier than a spin in the goal state).
 SPIN_DETOUR_BELOW = 0.3
-# A place where rolls failed this often (any target; within ROLL_SPOT_RADIUS metres) is not rolled at again:
-# some spots defeat every roll (the arm cannot reach round the object there), and trying each target in
-# turn at the same spot spent whole executions.
-ROLL_SPOT_FAILURES = 2
-ROLL_SPOT_RADIUS = 0.04
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 # Metres from the arm's base (the world origin) that an inflated footprint must stay within, so that the
@@ -141,16 +136,6 @@ class Step:
         return f"{self.skill:4s} {k}={value:10s} -> ({x:.3f}, {y:.3f})  P={self.p_success:.2f}"
 
 
-def failure_key(obj: ObjectModel, skill: str, params: dict, T_world_object: np.ndarray) -> tuple:
-    """What a failure is remembered by: (state, skill, parameter bucket relative to the object)."""
-    state, _, _, yaw = obj.planar_pose(T_world_object)
-    if skill == "push":
-        return state, skill, int(round(wrap_angle(params["direction"] - yaw) / (math.pi / 4))) % 8
-    if skill == "spin":
-        return state, skill, int(math.copysign(1, params["angle"]))
-    return state, skill, params["target"]
-
-
 def _disc(radius: float, n: int) -> np.ndarray:
     """A regular ``n``-gon of circumradius ``radius`` metres about the origin, (n, 2)."""
     a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
@@ -213,8 +198,7 @@ class Planner:
         self.seed = int(seed)
         self.clearance = clearance
         self.roll_margin = roll_margin
-        self.failures: Counter = Counter()
-        self.failed_roll_spots: list[tuple[float, float]] = []  # (x, y) of every failed roll, metres
+        self.memory = FailureMemory(obj)  # failed calls and roll spots (planner.memory)
         self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
         self._spin_rates: dict[tuple[int, int], np.ndarray] = {}  # (state, sense) -> P(spin) over SPIN_RATE_GRID
         self.reach = reach
@@ -233,8 +217,7 @@ class Planner:
         failures, the failed roll spots, the roll graph's penalties): what an execution learns from its failures
         stays in the fork, so running a plan never changes the plan's own planner."""
         other = copy.copy(self)
-        other.failures = Counter(self.failures)
-        other.failed_roll_spots = list(self.failed_roll_spots)
+        other.memory = self.memory.copy()
         other.graph = copy.copy(self.graph)
         other.graph.graph = self.graph.graph.copy()
         return other
@@ -257,23 +240,26 @@ class Planner:
 
     def record_failure(self, skill: str, params: dict, T_world_object: np.ndarray) -> int:
         """Remember a failed call; returns how often that (state, skill, parameter) has failed."""
-        key = failure_key(self.obj, skill, params, T_world_object)
-        self.failures[key] += 1
-        if skill == "roll":
-            self.failed_roll_spots.append((float(T_world_object[0, 3]), float(T_world_object[1, 3])))
-            if self.failures[key] >= FAILURES_TO_AVOID:
-                self.graph.penalise(key[0], params["target"])
-        return self.failures[key]
+        count = self.memory.record(skill, params, T_world_object)
+        if skill == "roll" and count >= FAILURES_TO_AVOID:
+            self.graph.penalise(self.obj.planar_pose(T_world_object)[0], params["target"])
+        return count
 
-    def _failed(self, skill: str, params: dict, T: np.ndarray) -> int:
-        """How often this (state, skill, parameter) has failed."""
-        return self.failures[failure_key(self.obj, skill, params, T)]
+    @property
+    def failures(self) -> Counter:
+        """The failed calls, by :func:`planner.memory.failure_key` (``self.memory.failures``)."""
+        return self.memory.failures
+
+    @property
+    def failed_roll_spots(self) -> list[tuple[float, float]]:
+        """(x, y) of every failed roll, metres (``self.memory.roll_spots``)."""
+        return self.memory.roll_spots
 
     def _avoided(self, skill: str, params: dict, T: np.ndarray) -> bool:
         """Whether the plan goes round this call: it failed twice, or (a push) the fingertip has no way in."""
         if skill == "push" and self.push_blocked(T, params["direction"]):
             return True
-        return self._failed(skill, params, T) >= FAILURES_TO_AVOID
+        return self.memory.avoided(skill, params, T)
 
     def push_blocked(self, T_world_object: np.ndarray, direction: float) -> bool:
         """Whether an obstacle stands where the fingertip must come down to push the object (at its settled
@@ -560,7 +546,7 @@ class Planner:
 
     def _spin_rating(self, state: int) -> float:
         """:meth:`_spin_probability`, or 0 where a spin in ``state`` (either way) has failed twice."""
-        if any(self.failures[(state, "spin", sense)] >= FAILURES_TO_AVOID for sense in (1, -1)):
+        if self.memory.spin_failed(state):
             return 0.0
         return self._spin_probability(state)
 
@@ -629,7 +615,7 @@ class Planner:
             return pushes
         turns = [float(wrap_angle(direction + sign * t)) for t in DETOUR_ANGLES for sign in (1.0, -1.0)]
         def rank(d: float) -> tuple:  # blocked, failed twice, landing in the way, failures: what _avoided weighs
-            failed = self._failed("push", {"direction": d}, T)
+            failed = self.memory.count("push", {"direction": d}, T)
             return self.push_blocked(T, d), failed >= FAILURES_TO_AVOID, not lands_free(d), failed
 
         return [min(turns, key=rank)]
@@ -709,21 +695,16 @@ class Planner:
                 return spot
         raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
 
-    def _spoiled(self, x: float, y: float) -> bool:
-        """Whether rolls failed :data:`ROLL_SPOT_FAILURES` times within :data:`ROLL_SPOT_RADIUS` of (x, y)."""
-        near = sum(math.hypot(x - fx, y - fy) <= ROLL_SPOT_RADIUS for fx, fy in self.failed_roll_spots)
-        return near >= ROLL_SPOT_FAILURES
-
     def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal) -> tuple[float, float] | None:
         """Where to roll: the object's own place when it has room, else the free spot (1 cm grid) nearest the
         object and then the goal."""
-        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self._spoiled(*cur[:2]):
+        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self.memory.spoiled(*cur[:2]):
             return float(cur[0]), float(cur[1])
         return _grid_argmin(self.workspace,
                             lambda px, py: math.hypot(px - cur[0], py - cur[1])
                             + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1]),
                             lambda px, py: room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2])
-                            and not self._spoiled(px, py))
+                            and not self.memory.spoiled(px, py))
 
 
 @dataclass
