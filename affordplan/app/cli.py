@@ -522,7 +522,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  affordplan bench fit-stuck runs/train100.json --held-out runs/train101.json")
     bf.add_argument("files", nargs="+", metavar="JSON", help="bench plan --json outputs")
     bf.add_argument("--held-out", nargs="+", metavar="JSON", default=None,
-                    help="other training-object runs, scored with the fitted rates")
+                    help="other runs, on any objects (scored, never fitted on), scored with the fitted rates")
     bf.add_argument("--json", action="store_true", help="print JSON instead of text")
     bf.set_defaults(func=_cmd_bench_fit_stuck)
     _register_robustness(bench_sub)

@@ -325,12 +325,13 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     return report
 
 
-def _training_plans(reports: Sequence[dict]) -> tuple[list[list[tuple[str, float]]], list[bool], int]:
+def _training_plans(reports: Sequence[dict], training: bool = True
+                    ) -> tuple[list[list[tuple[str, float]]], list[bool], int]:
     """The affordplan first plans' steps, whether each reached, and the runs' execution budget, from saved bench
-    runs on training objects."""
+    runs (on training objects, unless ``training`` is false)."""
     plans, reached, budgets = [], [], set()
     for report in reports:
-        if report.get("objects") != "training":
+        if training and report.get("objects") != "training":
             raise InputError(f"the stuck rates are fitted on --objects training runs only, got a run on "
                              f"{str(report.get('objects'))[:40]!r}")
         budgets.add(int(report["max_primitives"]))
@@ -350,7 +351,7 @@ def fit_stuck(reports: Sequence[dict], held_out: Sequence[dict] = (), grid_step:
     ``affordplan bench plan --objects training --json`` prints it): the rates whose first-plan ``p_success``
     (:func:`planner.odds.mc_odds` through the shipped outcome models, the runs' execution budget) has the least
     Brier score against whether the goal was reached (:func:`planner.odds.fit_stuck_rates`). ``held_out``: other
-    training runs, scored with the fitted rates and without stuck steps.
+    runs, on any objects (scored, never fitted on), scored with the fitted rates and without stuck steps.
 
     Returns ``dict(rates, plans, reached, brier, brier_without)``, with ``held_out=dict(plans, reached, brier,
     brier_without)`` when given.
@@ -368,7 +369,7 @@ def fit_stuck(reports: Sequence[dict], held_out: Sequence[dict] = (), grid_step:
     rates, brier, without = fit_stuck_rates(plans, reached, models, budget=budget, grid=grid, seed=seed)
     fit = dict(rates=rates, plans=len(plans), reached=float(np.mean(reached)), brier=brier, brier_without=without)
     if held_out:
-        plans, reached, budget = _training_plans(held_out)
+        plans, reached, budget = _training_plans(held_out, training=False)
         y = np.asarray(reached, dtype=float)
         scores = [float(np.mean((np.array([mc_odds(steps, models, budget, seed=seed, stuck_rate=r).p_success
                                            for steps in plans]) - y) ** 2)) for r in (rates, 0.0)]
