@@ -632,7 +632,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.choices["evaluate"].add_argument("--searched", default=None, metavar="PATH", nargs="+",
                                          help="with --frames: the searched success model to judge (default: the "
                                               "shipped one, if any); more paths judge others on the same rollouts "
-                                              "(reported under other_searched_models)")
+                                              "(reported under other_searched_models; with --plot, a diagram each)")
     sub.choices["train"].add_argument("--frames", default=None, metavar="shipped|PATH",
                                       help="train a searched success model: the skill acts with this frame search "
                                            "(frames.json, or the shipped one), the model rates it from the goal "
@@ -903,17 +903,17 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
         report = dict(path=str(searched_path if i else searched_path.name), all=metrics(q_i, success),
                       parameterised=metrics(q_i[par], success[par]))
         if i == 0:
-            q = q_i
             result["searched_model"] = dict(report, query_ms=1e3 * bench_query(searched.predict, obs))
         else:
             result.setdefault("other_searched_models", []).append(report)
+        if args.plot:  # P_searched.png, then P_searched2.png, ... for the others
+            path = Path(args.plot)
+            plot_reliability(q_i, success, path.with_name(f"{path.stem}_searched{i + 1 if i else ''}{path.suffix}"),
+                             f"{args.skill} searched success model{f' {i + 1}' if i else ''}, {args.objects}, "
+                             f"{args.sensor}")
     if args.plot:
         plot_reliability(p, success, args.plot,
                          f"{args.skill} success model, frame search, {args.objects}, {args.sensor}")
-        if "searched_model" in result:
-            path = Path(args.plot)
-            plot_reliability(q, success, path.with_name(path.stem + "_searched" + path.suffix),
-                             f"{args.skill} searched success model, {args.objects}, {args.sensor}")
     print(json.dumps(result, indent=2))
     return 0
 
