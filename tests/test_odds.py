@@ -64,6 +64,7 @@ def test_bad_probabilities_are_refused(bad):
 
 
 # ------------------------------------------------------------------ mc_odds: Monte Carlo through outcome models
+# (retries alone: stuck_rate=0.0; the shipped stuck rates have their own tests below)
 class Constant:
     """An outcome model whose every call achieves ``value`` of the asked effect."""
 
@@ -93,46 +94,47 @@ def test_mc_odds_is_deterministic_per_seed():
 
 @pytest.mark.parametrize("n_steps", [1, 3, 8])
 def test_calls_that_always_achieve_their_step_take_one_primitive_each(n_steps):
-    odds = mc_odds([("push", 0.05)] * n_steps, {"push": Constant(1.0)}, budget=20, n=100)
+    odds = mc_odds([("push", 0.05)] * n_steps, {"push": Constant(1.0)}, budget=20, n=100, stuck_rate=0.0)
     assert odds.p_success == 1.0 and odds.expected_primitives == n_steps
 
 
 def test_odds_fall_when_progress_halves():
     steps = [("push", 0.05)] * 4
-    assert mc_odds(steps, {"push": Constant(0.5)}, budget=8).expected_primitives == 8
-    assert mc_odds(steps, {"push": Constant(0.5)}, budget=7).p_success == 0.0
+    assert mc_odds(steps, {"push": Constant(0.5)}, budget=8, stuck_rate=0.0).expected_primitives == 8
+    assert mc_odds(steps, {"push": Constant(0.5)}, budget=7, stuck_rate=0.0).p_success == 0.0
     steps = [("push", 0.5)] * 4  # about 7 primitives at full progress, 14 at half
     full, half = _model("push"), _model("push", scale=0.5)
     for budget in (6, 10, 20):
-        assert mc_odds(steps, {"push": half}, budget).p_success < mc_odds(steps, {"push": full}, budget).p_success
-    assert (mc_odds(steps, {"push": half}, 200).expected_primitives
-            == pytest.approx(2 * mc_odds(steps, {"push": full}, 200).expected_primitives, rel=0.15))
+        slow, fast = (mc_odds(steps, {"push": m}, budget, stuck_rate=0.0) for m in (half, full))
+        assert slow.p_success < fast.p_success
+    assert (mc_odds(steps, {"push": half}, 200, stuck_rate=0.0).expected_primitives
+            == pytest.approx(2 * mc_odds(steps, {"push": full}, 200, stuck_rate=0.0).expected_primitives, rel=0.15))
 
 
 def test_the_budget_caps():
     steps = [("push", 0.5)] * 5
-    odds = mc_odds(steps, {"push": Constant(1.0)}, budget=3)
+    odds = mc_odds(steps, {"push": Constant(1.0)}, budget=3, stuck_rate=0.0)
     assert odds.p_success == 0.0 and odds.expected_primitives == 3 and odds.budget == 3
-    assert mc_odds(steps, {"push": Constant(0.0)}, budget=40).expected_primitives == 40
-    assert mc_odds(steps, {"push": Constant(1.0)}, budget=0).expected_primitives == 0
+    assert mc_odds(steps, {"push": Constant(0.0)}, budget=40, stuck_rate=0.0).expected_primitives == 40
+    assert mc_odds(steps, {"push": Constant(1.0)}, budget=0, stuck_rate=0.0).expected_primitives == 0
 
 
 def test_surplus_carries_over_within_a_stretch_of_one_skill_only():
     models = {"push": Constant(1.4), "roll": Constant(1.0), "spin": Constant(1.4)}
     # five pushes: 1.4, 2.8, 4.2, 5.6 -> four primitives
-    assert mc_odds([("push", 0.5)] * 5, models, budget=20).expected_primitives == 4
+    assert mc_odds([("push", 0.5)] * 5, models, budget=20, stuck_rate=0.0).expected_primitives == 4
     # a roll between two pairs of pushes: 2 + 1 + 2 primitives (no carry across the roll)
     steps = [("push", 0.5)] * 2 + [("roll", 0.5)] + [("push", 0.5)] * 2
-    assert mc_odds(steps, models, budget=20).expected_primitives == 5
+    assert mc_odds(steps, models, budget=20, stuck_rate=0.0).expected_primitives == 5
     # a spin after a push starts from nothing
-    assert mc_odds([("push", 0.5), ("spin", 0.5)], models, budget=20).expected_primitives == 2
+    assert mc_odds([("push", 0.5), ("spin", 0.5)], models, budget=20, stuck_rate=0.0).expected_primitives == 2
 
 
 def test_negative_progress_counts_zero_and_a_roll_needs_its_state():
-    assert mc_odds([("push", 0.5)], {"push": Constant(-3.0)}, budget=10).p_success == 0.0
+    assert mc_odds([("push", 0.5)], {"push": Constant(-3.0)}, budget=10, stuck_rate=0.0).p_success == 0.0
     roll_misses = {"roll": Constant(0.9)}
-    assert mc_odds([("roll", 0.9)], roll_misses, budget=10).p_success == 0.0
-    assert mc_odds([("roll", 0.9), ("roll", 0.9)], {"roll": Constant(2.0)}, 10).expected_primitives == 2
+    assert mc_odds([("roll", 0.9)], roll_misses, budget=10, stuck_rate=0.0).p_success == 0.0
+    assert mc_odds([("roll", 0.9), ("roll", 0.9)], {"roll": Constant(2.0)}, 10, stuck_rate=0.0).expected_primitives == 2
 
 
 def test_mc_odds_follows_the_geometric_model_for_all_or_nothing_calls():
@@ -140,19 +142,19 @@ def test_mc_odds_follows_the_geometric_model_for_all_or_nothing_calls():
     models = {s: OutcomeModel(s, np.full(1000, p), (np.arange(1000) < 1000 * p).astype(float), k=1000)
               for s, p in zip(("push", "spin", "roll"), q)}
     steps = [("push", 0.3), ("spin", 0.6), ("roll", 0.45)]
-    odds = mc_odds(steps, models, budget=9, n=20_000)
+    odds = mc_odds(steps, models, budget=9, n=20_000, stuck_rate=0.0)
     assert odds.p_success == pytest.approx(plan_odds(q, 9).p_success, abs=0.015)
 
 
 def test_an_empty_plan_has_reached_by_mc():
-    odds = mc_odds([], {}, budget=5)
+    odds = mc_odds([], {}, budget=5, stuck_rate=0.0)
     assert odds.p_success == 1.0 and odds.expected_primitives == 0.0
 
 
 @pytest.mark.parametrize("steps", [[("push", 1.5)], [("push", math.nan)], [("slide", 0.5)], [("push",)]])
 def test_mc_odds_refuses_bad_steps(steps):
     with pytest.raises(InputError):
-        mc_odds(steps, {"push": Constant(1.0)}, budget=10)
+        mc_odds(steps, {"push": Constant(1.0)}, budget=10, stuck_rate=0.0)
 
 
 def test_mc_odds_is_quick_enough_to_rate_every_plan():
@@ -163,7 +165,7 @@ def test_mc_odds_is_quick_enough_to_rate_every_plan():
     times = []
     for seed in range(5):
         t0 = time.perf_counter()
-        mc_odds(steps, models, budget=60, seed=seed)
+        mc_odds(steps, models, budget=60, seed=seed, stuck_rate=0.0)
         times.append(time.perf_counter() - t0)
     assert min(times) < 0.05  # ~3 ms on one idle core; generous for a loaded machine
 
@@ -223,3 +225,14 @@ def test_a_rate_per_skill_applies_to_that_skills_steps_only():
     steps = [("push", 0.5), ("roll", 0.5)]
     only_roll = mc_odds(steps, models, budget=200, n=20_000, stuck_rate={"push": 0.0, "roll": 1.0, "spin": 1.0})
     assert only_roll.p_success == pytest.approx(0.5, abs=0.015)
+
+
+def test_the_shipped_stuck_rates_make_a_doubtful_roll_a_doubtful_plan():
+    """With the shipped rates (roll 0.9), a roll rated 0.5 leaves a plan about 1 - 0.9 * 0.5 = 0.55 to reach its goal
+    however large the budget; retries alone would promise it."""
+    from planner.odds import STUCK_RATES
+
+    models = _all_or_nothing()
+    shipped = mc_odds([("roll", 0.5)], models, budget=200, n=20_000)
+    assert shipped.p_success == pytest.approx(1.0 - STUCK_RATES["roll"] * 0.5, abs=0.015)
+    assert mc_odds([("roll", 0.5)], models, budget=200, n=20_000, stuck_rate=0.0).p_success > 0.99
