@@ -7,6 +7,7 @@ what answering a query needs: the network, the policy-decision features and the 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -164,24 +165,25 @@ class SuccessModel:
     @torch.no_grad()
     def predict(self, obs: np.ndarray) -> np.ndarray:
         """P(success) for observations ``(N, 9)`` or ``(B, N, 9)``."""
-        x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
-        single = x.ndim == 2
-        x = x[None] if single else x
-        _, _, d = decision_features(self.policy, x)
-        p = self._stacked(x, d).numpy()
-        return p[0] if single else p
+        return self._per_observation(obs, lambda x, d: self._stacked(x, d))
 
     @torch.no_grad()
     def spread(self, obs: np.ndarray) -> np.ndarray:
         """The members' disagreement on P(success) for observations ``(N, 9)`` or ``(B, N, 9)``: the standard
         deviation of their calibrated probabilities (0 for a one-member net). Low on observations like those the
         model was fitted on, higher where they did not settle the answer; it is not itself a probability."""
+        return self._per_observation(
+            obs, lambda x, d: self._stacked.member_probabilities(x, d).std(dim=0, correction=0))
+
+    def _per_observation(self, obs: np.ndarray,
+                         answer: Callable[[torch.Tensor, torch.Tensor], torch.Tensor]) -> np.ndarray:
+        """``answer(observations (B, N, 9), the policy's decision features)`` for ``(N, 9)`` or ``(B, N, 9)``."""
         x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
         single = x.ndim == 2
         x = x[None] if single else x
         _, _, d = decision_features(self.policy, x)
-        s = self._stacked.member_probabilities(x, d).std(dim=0, correction=0).numpy()
-        return s[0] if single else s
+        out = answer(x, d).numpy()
+        return out[0] if single else out
 
 
 def load_success_net(skill: str, path: str | os.PathLike | None = None) -> SuccessNet:

@@ -416,3 +416,16 @@ def test_a_contact_encoder_learns_round_trips_and_answers_as_its_stacked_form(tm
     assert np.allclose(StackedEnsemble(again)(obs, dec).numpy(), p, atol=1e-6)
     with pytest.raises(InputError):
         success.SuccessNet(encoder="voxels")
+
+
+@pytest.mark.parametrize("objects", ["test", "housekeep:unseen", "train+housekeep:unseen_class_thick",
+                                     "housekeep:training+housekeep:unseen_instance"])
+def test_fitting_refuses_held_out_objects_and_evaluating_takes_them(objects):
+    from primitives.training.success import check_objects
+
+    with pytest.raises(InputError, match="held out"):
+        check_objects(objects, fitting=True)
+    check_objects(objects, fitting=False)
+    check_objects("train+housekeep:training", fitting=True)
+    with pytest.raises(InputError, match="housekeep split"):
+        check_objects("housekeep:nope", fitting=False)

@@ -508,7 +508,7 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--objects", default="procedural", choices=["procedural", "household", "mixed", "training"],
                     help="the tasks' objects: the procedural test split, HACMan's 25 unseen household meshes, or "
                          "the two by turns; training: the training objects by turns, for fitting the planner's "
-                         "stuck rate, never for reporting (default: %(default)s)")
+                         "stuck rates, never for reporting (default: %(default)s)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     bf = bench_sub.add_parser(

@@ -800,17 +800,20 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-HELD_OUT = ("test", "housekeep:unseen", "housekeep:unseen_thick", "housekeep:unseen_instance",
-            "housekeep:unseen_class", "housekeep:unseen_instance_thick", "housekeep:unseen_class_thick")
+def held_out(spec: str) -> bool:
+    """Whether one ``+``-part of ``--objects`` is held out for evaluation: the procedural test split, or any of HACMan's
+    unseen household splits (``housekeep:unseen``, ``unseen_instance``, ``unseen_class`` and their ``_thick``
+    lists)."""
+    return spec == "test" or spec.startswith("housekeep:unseen")
 
 
 def check_objects(objects: str, fitting: bool) -> None:
     """Raise :class:`InputError` for an ``--objects`` naming no objects, or, when ``fitting`` (a model or a
     calibration is fitted on them), naming a held-out split: test objects are never trained, tuned or selected on."""
     object_groups(objects, 1)
-    held_out = [spec for spec in objects.split("+") if spec in HELD_OUT]
-    if fitting and held_out:
-        raise InputError(f"--objects {objects}: {', '.join(held_out)} is held out for evaluation; fit on train, "
+    held = [spec for spec in objects.split("+") if held_out(spec)]
+    if fitting and held:
+        raise InputError(f"--objects {objects}: {', '.join(held)} is held out for evaluation; fit on train, "
                          "housekeep:training or housekeep:validation")
 
 
@@ -893,13 +896,13 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
                   frames_per_query=len(frames))
     searched_paths = ([Path(path) for path in args.searched] if args.searched
                       else [weights_file.SHIPPED_DIR / f"{args.skill}_success_searched.pt"])
+    obs_all, decision = torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)
     for i, searched_path in enumerate(searched_paths):
         if not (args.searched or searched_path.exists()):
             break
         searched = SuccessModel(model.policy, load_success_net(args.skill, searched_path))
         with torch.no_grad():
-            q_i = searched.net(torch.from_numpy(data.obs.astype(np.float32)),
-                               torch.from_numpy(data.decision)).numpy()
+            q_i = searched.net(obs_all, decision).numpy()
         report = dict(path=str(searched_path if i else searched_path.name), all=metrics(q_i, success),
                       parameterised=metrics(q_i[par], success[par]))
         if i == 0:

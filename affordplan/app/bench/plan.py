@@ -44,7 +44,7 @@ RARE_GOAL_STATE = 0.05
 # What the tasks' objects are: the procedural test split, HACMan's unseen household meshes (never trained on,
 # housekeep.names("unseen")), or the two by turns (even tasks procedural, odd ones household); "training": the
 # training objects by turns (procedural train split, housekeep.names("training")), for fitting what the planner
-# learns from plan outcomes (planner.odds.STUCK_RATE), never for reporting.
+# learns from plan outcomes (planner.odds.STUCK_RATES), never for reporting.
 OBJECT_SETS = ("procedural", "household", "mixed", "training")
 
 
