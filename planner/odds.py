@@ -209,15 +209,16 @@ def fit_stuck_rates(plans: Sequence[Sequence[tuple[str, float]]], reached: Seque
     y = np.asarray(reached, dtype=float)
     base = np.array([mc_odds(steps, models, budget, seed=seed, n=n, stuck_rate=0.0).p_success for steps in plans])
     used = sorted({skill for steps in plans for skill, _ in steps})
-    # per plan and skill, every step's (1 - q): the stuck factor is prod over steps of 1 - r[skill] * (1 - q)
-    misses = [{skill: np.array([1.0 - q for k, q in steps if k == skill]) for skill in used} for steps in plans]
     grid = np.asarray(grid, dtype=float)
-    best, best_score = None, np.inf
-    for combo in np.array(np.meshgrid(*[grid] * len(used), indexing="ij")).reshape(len(used), -1).T:
-        p = base * np.array([np.prod([np.prod(1.0 - r * miss[skill]) for skill, r in zip(used, combo)])
-                             for miss in misses])
-        score = float(np.mean((p - y) ** 2))
-        if score < best_score - 1e-12:
-            best, best_score = combo, score
+    # factors[i][g, j]: plan j's stuck factor from skill used[i]'s steps at rate grid[g], prod of 1 - r * (1 - q)
+    factors = [np.array([[np.prod(1.0 - r * np.array([1.0 - q for k, q in steps if k == skill])) for steps in plans]
+                         for r in grid]) for skill in used]
+    # every combination of rates at once: p[g_0, ..., g_k, j] = base[j] * prod_i factors[i][g_i, j]
+    p = base
+    for i, f in enumerate(factors):
+        p = p[..., None, :] * f.reshape((1,) * i + f.shape)
+    scores = np.mean((p - y) ** 2, axis=-1)
+    best = [grid[g] for g in np.unravel_index(int(np.argmin(scores)), scores.shape)]
+    best_score = float(scores.min())
     rates = {skill: 0.0 for skill in STUCK_RATES} | {skill: float(r) for skill, r in zip(used, best)}
     return rates, best_score, float(np.mean((base - y) ** 2))

@@ -19,17 +19,21 @@ SHIMS = {
 }
 
 
-def _run(*args: str) -> subprocess.CompletedProcess:
+@pytest.fixture(scope="module")
+def helped() -> dict[str, tuple[int, str, str]]:
+    """``python -m SHIM --help`` of every shim, run at once (each pays torch's import): returncode, stdout, stderr."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.run([sys.executable, "-m", *args], capture_output=True, text=True, cwd=ROOT, env=env,
-                          timeout=120)
+    procs = {module: subprocess.Popen([sys.executable, "-m", module, "--help"], stdout=subprocess.PIPE,
+                                      stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env) for module in SHIMS}
+    outputs = {module: proc.communicate(timeout=120) for module, proc in procs.items()}
+    return {module: (procs[module].returncode, *outputs[module]) for module in SHIMS}
 
 
 @pytest.mark.parametrize("module", sorted(SHIMS))
-def test_the_shim_runs_the_machinery_s_command_line(module):
-    helped = _run(module, "--help")
-    assert helped.returncode == 0, helped.stderr
-    assert helped.stdout.startswith(f"usage: python -m {module} ")  # the prog name is the command as typed
+def test_the_shim_runs_the_machinery_s_command_line(module, helped):
+    returncode, stdout, stderr = helped[module]
+    assert returncode == 0, stderr
+    assert stdout.startswith(f"usage: python -m {module} ")  # the prog name is the command as typed
 
 
 @pytest.mark.parametrize("module", sorted(SHIMS))

@@ -41,7 +41,7 @@ def _poll(source, n: int) -> list:
     raise AssertionError(f"only {len(got)} of {n} transitions arrived")
 
 
-@pytest.mark.parametrize("backend", ["ray", "local"])
+@pytest.mark.parametrize("backend", [pytest.param("ray", marks=pytest.mark.slow), "local"])  # Ray starts in ~5 s
 def test_pushed_weights_reach_the_workers(backend, request):
     """Workers start with a policy that moves along -1 and, after a push, act with one that moves along +1."""
     env_cfg = EnvConfig("push", objects=("cube",), n_points=32)

@@ -37,10 +37,11 @@ from tqdm import tqdm
 
 from affordplan.errors import AffordplanError
 from affordplan.log import cli_logging
+from affordplan.sim.sensor import SENSORS
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
-from primitives.training.env import PRIMITIVES, PrimitiveEnv
-from primitives.training.evaluate import greedy_action, held_out_config, load_policy
+from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv
+from primitives.training.evaluate import greedy_action, held_out_config, load_policy, object_list
 from primitives.training.success import SuccessModel, auroc, load_success_net
 
 
@@ -154,17 +155,29 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
 
 
 def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: int = 1234,
-                  weights=None, model=None, frames: str = "shipped", progress: bool = True) -> FrameCeiling:
+                  weights=None, model=None, frames: str = "shipped", progress: bool = True,
+                  objects: str = "random", sensor: str = "cameras") -> FrameCeiling:
     """Every option of ``starts`` held-out starts of ``skill`` (``params``: ``"random"`` asks for a random
     parameter, ``"none"`` the seed's objective), with the policy ``weights``, the success model ``model`` and the
-    frame search ``frames`` (``"shipped"`` or a frames.json path; defaults: the shipped ones)."""
+    frame search ``frames`` (``"shipped"`` or a frames.json path; defaults: the shipped ones).
+
+    ``objects``: ``"random"`` (the procedural test split, the evaluation's starts) or what
+    :func:`primitives.training.evaluate.object_list` takes (e.g. ``"housekeep:validation"``), the starts then
+    cycling through its objects; ``sensor``: the clouds the policy and the ratings see."""
     policy = load_policy(weights, skill)
     predict = SuccessModel(policy, load_success_net(skill, model)).predict
     search = load_frame_search(skill, frames)
-    env = PrimitiveEnv(held_out_config(skill, 1.0 if params == "random" else 0.0), seed=seed)
+    p_params = 1.0 if params == "random" else 0.0
+    if objects == "random":
+        env, keys = PrimitiveEnv(held_out_config(skill, p_params, sensor), seed=seed), [None] * starts
+    else:
+        names = object_list(objects)
+        env = PrimitiveEnv(EnvConfig(skill, objects=names, episodes_per_object=1, p_params=p_params, sensor=sensor),
+                           seed=seed)
+        keys = [names[i % len(names)] for i in range(starts)]
     out = FrameCeiling(skill, params, [])
-    for _ in tqdm(range(starts), desc=f"{skill} frame ceiling", disable=not progress, unit="start", mininterval=2.0):
-        env.reset()
+    for key in tqdm(keys, desc=f"{skill} frame ceiling", disable=not progress, unit="start", mininterval=2.0):
+        env.reset(object_key=key)
         out.starts.append(start_options(env, policy, search, predict))
     env.close()
     return out
@@ -193,6 +206,9 @@ def build_parser() -> argparse.ArgumentParser:
                "  python -m primitives.research.frame_ceiling push --starts 100 --params none --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     add_held_out_arguments(p)
+    p.add_argument("--objects", default="random",
+                   help="random (the procedural test split) or e.g. housekeep:validation (default: random)")
+    p.add_argument("--sensor", choices=SENSORS, default="cameras", help="the clouds seen (default: cameras)")
     return p
 
 
@@ -205,7 +221,7 @@ def main(argv: list[str] | None = None) -> int:
     torch.set_num_threads(1)
     try:
         result = frame_ceiling(args.skill, args.starts, args.params, args.seed, args.weights, args.model,
-                               args.frames, progress=not args.json)
+                               args.frames, progress=not args.json, objects=args.objects, sensor=args.sensor)
     except AffordplanError as exc:  # missing or broken weights, an unreadable frames file, ...
         print(f"primitives.research.frame_ceiling: error: {exc}", file=sys.stderr)
         return 2
