@@ -66,3 +66,14 @@ def test_within_start_auroc_counts_only_starts_with_mixed_outcomes():
     assert result.as_dict()["mixed_share"] == pytest.approx(2 / 3)
     assert result.rates()["search's pick"] == pytest.approx(2 / 3)
     assert result.rates()["best option"] == 1.0
+
+
+@pytest.mark.slow
+def test_named_objects_give_the_same_pick_as_evaluate_on_them():
+    """``objects``: the starts cycle through the named objects, as ``evaluate`` draws them, seen by ``sensor``."""
+    result = frame_ceiling("spin", starts=2, params="random", seed=1234, progress=False, objects="mug",
+                           sensor="surface")
+    searched = evaluate(load_policy(None, "spin"), "spin", objects="mug", trials=2, seed=1234, p_params=1.0,
+                        progress=False, sensor="surface", frame_search=load_frame_search("spin", "shipped"))
+    assert (result.objects, result.sensor) == ("mug", "surface")
+    assert [bool(o.success[o.pick]) for o in result.starts] == searched.outcomes

@@ -76,6 +76,8 @@ class FrameCeiling:
     skill: str
     params: str
     starts: list[StartOptions]
+    objects: str = "random"
+    sensor: str = "cameras"
 
     def rates(self) -> dict[str, float]:
         s = self.starts
@@ -91,14 +93,15 @@ class FrameCeiling:
         return float(np.mean(values)) if values else None
 
     def as_dict(self) -> dict:
-        return dict(skill=self.skill, params=self.params, starts=len(self.starts),
+        return dict(skill=self.skill, params=self.params, objects=self.objects, sensor=self.sensor,
+                    starts=len(self.starts),
                     options_per_start=float(np.mean([len(o.success) for o in self.starts])),
                     success=self.rates(), mixed_share=float(np.mean([o.mixed for o in self.starts])),
                     within_start_auroc=self.within_start_auroc())
 
     def report(self) -> str:
         d = self.as_dict()
-        lines = [f"{self.skill}, params {self.params}: {d['starts']} held-out starts, "
+        lines = [f"{self.skill}, params {self.params}, {self.objects} objects, {self.sensor}: {d['starts']} starts, "
                  f"{d['options_per_start']:.1f} options each, every one executed from the start"]
         lines += [f"  {name:<15} {rate:.3f}" for name, rate in d["success"].items()]
         auc = d["within_start_auroc"]
@@ -122,7 +125,8 @@ class FrameCeiling:
         ax.set_xticks(range(len(rates)), list(rates), rotation=15)
         ax.set_ylim(0, 1.05)
         ax.set_ylabel("success rate")
-        ax.set_title(f"{self.skill}, params {self.params}: every option executed from {len(self.starts)} starts")
+        ax.set_title(f"{self.skill}, params {self.params}: every option executed from {len(self.starts)} starts\n"
+                     f"({self.objects} objects, {self.sensor})", fontsize=10)
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)
@@ -175,7 +179,7 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
         env = PrimitiveEnv(EnvConfig(skill, objects=names, episodes_per_object=1, p_params=p_params, sensor=sensor),
                            seed=seed)
         keys = [names[i % len(names)] for i in range(starts)]
-    out = FrameCeiling(skill, params, [])
+    out = FrameCeiling(skill, params, [], objects, sensor)
     for key in tqdm(keys, desc=f"{skill} frame ceiling", disable=not progress, unit="start", mininterval=2.0):
         env.reset(object_key=key)
         out.starts.append(start_options(env, policy, search, predict))
