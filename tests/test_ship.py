@@ -124,3 +124,12 @@ def test_sets_that_cannot_ship_are_refused(layout, case):
     with pytest.raises(InputError):
         plan_ship(skill, source, keep, weights_dir=weights, base=base)
     assert sorted(p.name for p in weights.rglob("*")) == before
+
+
+def test_portable_drops_the_checkout_s_path_from_every_string(tmp_path):
+    from primitives.research.ship import portable
+
+    info = {"model": f"{tmp_path}/runs/a/success.pt", "command": f"python -m x --out {tmp_path}/runs/b --flag",
+            "nested": [f"{tmp_path}", 3, {"frames": "shipped"}]}
+    assert portable(info, tmp_path) == {"model": "runs/a/success.pt", "command": "python -m x --out runs/b --flag",
+                                        "nested": [".", 3, {"frames": "shipped"}]}

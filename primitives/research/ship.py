@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import os
 import shutil
 import sys
 from dataclasses import dataclass, field, replace
@@ -42,6 +43,7 @@ from primitives.frames import FrameSearch
 from primitives.training.env import PRIMITIVES
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
+REPO_ROOT = Path(__file__).resolve().parents[2]
 ROLES = ("policy", "model", "frames")  # the info keys of a fitted file that name the files it was fitted with
 SHIPPED = "shipped"
 
@@ -158,9 +160,23 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
     return plan
 
 
+def portable(value, root: Path = REPO_ROOT):
+    """``value`` with every mention of the repository's absolute path ``root`` dropped from its strings (in dicts and
+    lists too), so that a shipped file names its runs as ``runs/...``, not by where this checkout lies."""
+    if isinstance(value, str):
+        return value.replace(f"{root}{os.sep}", "").replace(str(root), ".")
+    if isinstance(value, dict):
+        return {k: portable(v, root) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(portable(v, root) for v in value)
+    return value
+
+
 def relabel(path: Path, release: str, digests: dict[str, str]) -> None:
-    """Rewrite the ``info`` of a fitted file as shipped (module docstring, step 3); its model is untouched."""
+    """Rewrite the ``info`` of a fitted file as shipped (module docstring, step 3), its paths made
+    :func:`portable`; its model is untouched."""
     def update(info: dict) -> dict:
+        info = portable(info)
         trained_with = {role: info[role] for role in ROLES if role in info and info[role] != SHIPPED}
         if not trained_with:
             return info
