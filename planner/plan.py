@@ -560,7 +560,8 @@ class Planner:
         The detour is taken when a turn is needed (the route rolls, or the start's yaw is off the goal's), the
         goal's state spins badly (:data:`SPIN_DETOUR_BELOW`), the route's last roll does not come from a state
         that spins better (:meth:`_turns_better`: the turn is made there), and for the best neighbour ``s``,
-        ``P(roll g->s) P(spin in s) P(roll s->g)`` beats ``P(spin in g)``.
+        ``P(roll g->s) P(spin in s) P(roll s->g)`` beats ``P(spin in g)``; a neighbour whose roll from ``g``
+        failed twice is not tried again (:meth:`FailureMemory.roll_failed`).
         """
         g = route[-1]
         if len(route) == 1 and goal.yaw_error(self.obj, g, yaw) <= goal.yaw_tol:
@@ -570,6 +571,8 @@ class Planner:
         best, best_p = None, self._spin_rating(g)
         for s in self.graph.graph.successors(g):
             if s == g or not self.graph.graph.has_edge(s, g) or not self._turns_better(s, g):
+                continue
+            if self.memory.roll_failed(g, s):  # a spin rated 0 (failed twice) would otherwise keep any detour
                 continue
             p = self.graph.probability(g, s) * self._spin_rating(s) * self.graph.probability(s, g)
             if p > best_p:

@@ -186,6 +186,11 @@ def test_a_goal_state_that_cannot_be_spun_is_left_and_rolled_back_into_to_turn()
     route = planner.plan(T0, goal).route
     assert len(route) == 3
     assert route[0] == route[-1] == 0 and route[1] != 0  # left, and rolled back into
+    # ... but not by a roll that failed twice: every neighbour's roll failed twice, so no detour is left
+    for s in {int(n) for n in planner.graph.graph.successors(0)} - {0}:
+        for _ in range(2):
+            planner.record_failure("roll", {"target": s}, T0)
+    assert planner.plan(T0, goal).route == [0]
     aligned = ap.Goal(xy=(0.6, 0.05), yaw=math.radians(5.0), resting_state=0)
     plan = Planner(cube, (), predictor=RatesBadlyIn(skills, cube, 0, "spin"), time_limit=5.0, seed=0).plan(T0, aligned)
     assert plan.route == [0]
