@@ -210,9 +210,11 @@ def fit_stuck_rates(plans: Sequence[Sequence[tuple[str, float]]], reached: Seque
     base = np.array([mc_odds(steps, models, budget, seed=seed, n=n, stuck_rate=0.0).p_success for steps in plans])
     used = sorted({skill for steps in plans for skill, _ in steps})
     grid = np.asarray(grid, dtype=float)
+    # misses[i][j]: every (1 - q) of plan j's steps of skill used[i]
+    misses = [[np.array([1.0 - q for k, q in steps if k == skill]) for steps in plans] for skill in used]
     # factors[i][g, j]: plan j's stuck factor from skill used[i]'s steps at rate grid[g], prod of 1 - r * (1 - q)
-    factors = [np.array([[np.prod(1.0 - r * np.array([1.0 - q for k, q in steps if k == skill])) for steps in plans]
-                         for r in grid]) for skill in used]
+    factors = [np.array([[np.prod(1.0 - r * miss) for miss in skill_misses] for r in grid])
+               for skill_misses in misses]
     # every combination of rates at once: p[g_0, ..., g_k, j] = base[j] * prod_i factors[i][g_i, j]
     p = base
     for i, f in enumerate(factors):

@@ -40,7 +40,15 @@ def test_a_place_where_rolls_failed_twice_is_spoiled():
     assert not memory.spoiled(0.5, 0.0)
     memory.record("roll", {"target": 2}, cube.resting_states[0].pose((0.52, 0.0), 0.0))
     assert memory.spoiled(0.51, 0.0)
-    assert not memory.roll_failed(0, 1)  # spoiled spots are about places; roll_failed about a (state, target)
+    assert not memory.spoiled(0.5 + 2.5 * ROLL_SPOT_RADIUS, 0.0)
+
+
+def test_a_roll_that_failed_twice_anywhere_has_failed():
+    """``roll_failed`` counts a (state, target), wherever the rolls were tried; spoiled spots count places."""
+    cube = ap.load_object("cube")
+    memory = FailureMemory(cube)
+    memory.record("roll", {"target": 1}, cube.resting_states[0].pose((0.5, 0.0), 0.0))
+    memory.record("roll", {"target": 2}, cube.resting_states[0].pose((0.52, 0.0), 0.0))
+    assert not memory.roll_failed(0, 1)
     memory.record("roll", {"target": 1}, cube.resting_states[0].pose((0.2, 0.3), 0.0))
     assert memory.roll_failed(0, 1) and not memory.roll_failed(0, 2)
-    assert not memory.spoiled(0.5 + 2.5 * ROLL_SPOT_RADIUS, 0.0)

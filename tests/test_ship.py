@@ -12,7 +12,7 @@ import torch
 
 from affordplan.errors import InputError
 from primitives import load_skill, weights_file
-from primitives.research.ship import main, plan_ship, ship
+from primitives.research.ship import main, plan_ship, portable, ship
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
 
 CANDIDATES = Path(__file__).resolve().parents[1] / "candidates"
@@ -127,8 +127,6 @@ def test_sets_that_cannot_ship_are_refused(layout, case):
 
 
 def test_portable_drops_the_checkout_s_path_from_every_string(tmp_path):
-    from primitives.research.ship import portable
-
     info = {"model": f"{tmp_path}/runs/a/success.pt", "command": f"python -m x --out {tmp_path}/runs/b --flag",
             "nested": [f"{tmp_path}", 3, {"frames": "shipped"}]}
     assert portable(info, tmp_path) == {"model": "runs/a/success.pt", "command": "python -m x --out runs/b --flag",

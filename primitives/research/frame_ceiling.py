@@ -40,8 +40,14 @@ from affordplan.log import cli_logging
 from affordplan.sim.sensor import SENSORS
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
-from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv
-from primitives.training.evaluate import greedy_action, held_out_config, load_policy, object_list
+from primitives.training.env import PRIMITIVES, PrimitiveEnv
+from primitives.training.evaluate import (
+    greedy_action,
+    held_out_config,
+    load_policy,
+    named_objects_config,
+    object_list,
+)
 from primitives.training.success import SuccessModel, auroc, load_success_net
 
 
@@ -176,8 +182,7 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
         env, keys = PrimitiveEnv(held_out_config(skill, p_params, sensor), seed=seed), [None] * starts
     else:
         names = object_list(objects)
-        env = PrimitiveEnv(EnvConfig(skill, objects=names, episodes_per_object=1, p_params=p_params, sensor=sensor),
-                           seed=seed)
+        env = PrimitiveEnv(named_objects_config(skill, names, p_params, sensor), seed=seed)
         keys = [names[i % len(names)] for i in range(starts)]
     out = FrameCeiling(skill, params, [], objects, sensor)
     for key in tqdm(keys, desc=f"{skill} frame ceiling", disable=not progress, unit="start", mininterval=2.0):

@@ -98,6 +98,13 @@ def held_out_config(primitive: str, p_params: float, sensor: str = "cameras") ->
                      sensor=sensor)
 
 
+def named_objects_config(primitive: str, names: tuple[str, ...], p_params: float,
+                         sensor: str = "cameras") -> EnvConfig:
+    """The environment of an evaluation on named objects (:func:`object_list`): each reset names its object, one
+    episode per draw."""
+    return EnvConfig(primitive, objects=names, episodes_per_object=1, p_params=p_params, sensor=sensor)
+
+
 def object_list(objects: str | tuple[str, ...]) -> tuple[str, ...]:
     """The objects an evaluation runs on: ``seed7`` (the seed's procedural seven), ``seed7:real`` (their real
     counterparts, :data:`SEED_SEVEN_REAL`), ``housekeep:SPLIT`` (e.g. ``housekeep:unseen``), or names / paths."""
@@ -138,7 +145,7 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
         plan = [None] * trials
     else:
         names = object_list(objects)
-        cfg = EnvConfig(primitive, objects=names, episodes_per_object=1, p_params=p_params, sensor=sensor)
+        cfg = named_objects_config(primitive, names, p_params, sensor)
         plan = [n for n in names for _ in range(trials)]
     env = PrimitiveEnv(cfg, seed=seed)
     result = EvalResult(primitive, objects if isinstance(objects, str) else "paths", sensor=sensor,
