@@ -119,14 +119,16 @@ class Predictor:
 
     def p_success_many(self, queries: list[tuple[str, dict | None, np.ndarray]]) -> np.ndarray:
         """Batched :meth:`p_success` (one network pass per skill)."""
-        out = self._ask(queries, lambda skill, obs, parameterised: skill.success_probability_obs(obs, parameterised))
+        out = self._ask(queries, lambda skill, obs, parameterised: skill.success_probability_obs(obs, parameterised,
+                                                                                          sensor=self.sensor))
         self.queries += len(queries)
         return out
 
     def spread_many(self, queries: list[tuple[str, dict | None, np.ndarray]]) -> np.ndarray:
         """The success models' member disagreement on each of :meth:`p_success_many`'s queries
         (:meth:`primitives.skills.Skill.success_spread_obs`): how uncertain each rating is."""
-        return self._ask(queries, lambda skill, obs, parameterised: skill.success_spread_obs(obs, parameterised))
+        return self._ask(queries, lambda skill, obs, parameterised: skill.success_spread_obs(obs, parameterised,
+                                                                                      sensor=self.sensor))
 
     def _ask(self, queries: list[tuple[str, dict | None, np.ndarray]],
              answer: Callable[[Skill, np.ndarray, bool], np.ndarray]) -> np.ndarray:

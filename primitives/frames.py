@@ -58,7 +58,7 @@ from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives import params as skill_params
 from primitives.observation import OBS_DIM, SkillObservation, observe_cloud
-from primitives.weights_file import SHIPPED_DIR
+from primitives.weights_file import ratings_dir
 
 if TYPE_CHECKING:
     from affordplan.sim import Simulator
@@ -258,17 +258,19 @@ class FrameSearch:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
 
 
-def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None) -> FrameSearch | None:
+def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None,
+                         sensor: str | None = None) -> FrameSearch | None:
     """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
-    package's ``weights/``), if any."""
-    path = Path(weights_dir or SHIPPED_DIR) / f"{name}_frames.json"
+    package's ``weights/``; for ``sensor``'s clouds where one was fitted to them,
+    :func:`primitives.weights_file.ratings_dir`), if any."""
+    path = ratings_dir(name, sensor, weights_dir) / f"{name}_frames.json"
     return FrameSearch.load(path) if path.exists() else None
 
 
-def load_frame_search(skill: str, frames: str | os.PathLike) -> FrameSearch:
-    """``"shipped"``: the frame search shipped beside ``skill``'s weights; else the frames.json at ``frames``.
-    Raises :class:`InputError` where none is shipped or the file is unreadable."""
-    search = shipped_frame_search(skill) if str(frames) == "shipped" else FrameSearch.load(frames)
+def load_frame_search(skill: str, frames: str | os.PathLike, sensor: str | None = None) -> FrameSearch:
+    """``"shipped"``: the frame search shipped beside ``skill``'s weights (for ``sensor``'s clouds); else the
+    frames.json at ``frames``. Raises :class:`InputError` where none is shipped or the file is unreadable."""
+    search = shipped_frame_search(skill, sensor=sensor) if str(frames) == "shipped" else FrameSearch.load(frames)
     if search is None:
         raise InputError(f"no frame search is shipped for {skill}")
     return search

@@ -20,6 +20,14 @@ the cloud in the goal frames its request leaves free and acts in the one its suc
 beside their weights (``weights/{name}_frames.json``) where there is one; without, they act in the goal frame, as
 trained.
 
+**Ratings per sensor**: a success model, and the calibration of a frame search built on it, are fitted to clouds of
+one sensor; depth-camera clouds and the privileged surface sample differ (partial views, estimated normals), and
+ratings fitted to one misrank the options of the other. The ratings shipped beside a policy are for the sensor it
+was trained on (:attr:`Skill.sensor`); a folder ``weights/{sensor}/`` may hold the same skill's ratings fitted to
+another sensor's clouds (``{name}_success.pt``, ``{name}_frames.json``, ``{name}_success_searched.pt``: the same
+policy, fitted together). A skill called on a simulator then rates and picks its options with the ratings of that
+simulator's sensor (:meth:`Skill.ratings`), and a planner predicting clouds of a sensor asks for that sensor's.
+
 **Searched success model**: rating a request through the frame search runs the policy once per free frame (12
 for a spin by an angle: ~22 ms on one core). Where one is shipped (``weights/{name}_success_searched.pt``,
 ``python -m primitives.success train NAME --frames shipped``), ``success_probability`` asks it instead: a success
@@ -36,6 +44,7 @@ import numpy as np
 import torch
 
 from affordplan.errors import InputError, ReachabilityError
+from affordplan.sim.sensor import SENSORS
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import rewards
 from primitives.frames import FrameSearch, reframe_obs, shipped_frame_search  # noqa: F401 (re-exported)
@@ -51,11 +60,17 @@ UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact
 
 
 class Skill:
-    """A trained primitive acting greedily on a simulator's point cloud, with its success model."""
+    """A trained primitive acting greedily on a simulator's point cloud, with its success model.
+
+    ``success_weights``, ``frame_search`` and ``searched_weights`` are the ratings for clouds of the sensor the
+    policy was trained on (:attr:`sensor`); ``ratings_by_sensor`` maps another sensor's name to a :class:`Skill`
+    of the same policy whose ratings were fitted to that sensor's clouds (:meth:`ratings`).
+    """
 
     def __init__(self, name: SkillName, model: HybridActorCritic, n_points: int = 256,
                  success_weights: str | os.PathLike | None = None, frame_search: FrameSearch | None = None,
-                 searched_weights: str | os.PathLike | None = None):
+                 searched_weights: str | os.PathLike | None = None,
+                 ratings_by_sensor: dict[str, Skill] | None = None):
         self.name: SkillName = name
         self.model = model
         # The clouds the policy was trained on (its weights' metadata): what a simulator should show it.
@@ -66,6 +81,20 @@ class Skill:
         self.frame_search = frame_search
         self._searched_weights = searched_weights
         self._searched: SuccessModel | None = None
+        self._by_sensor = dict(ratings_by_sensor or {})
+        for sensor, other in self._by_sensor.items():
+            if other.model is not model or other.name != name:
+                raise InputError(f"the {sensor} ratings of {name} must be for the same policy")
+
+    def ratings(self, sensor: str | None) -> Skill:
+        """The skill whose ratings (success model, frame search, searched model) fit clouds of ``sensor``: this one,
+        or the one fitted to that sensor's clouds where there is one (same policy). ``None``: this one."""
+        return self._by_sensor.get(sensor, self) if sensor is not None and sensor != self.sensor else self
+
+    @property
+    def rated_sensors(self) -> tuple[str, ...]:
+        """The sensors this skill has ratings fitted for: its policy's own first."""
+        return (self.sensor, *sorted(self._by_sensor))
 
     def frames(self, params: ParamsLike) -> np.ndarray:
         """The goal frames this skill tries for (checked) ``params``: ``(m, 3, 3)``, the identity first."""
@@ -73,7 +102,11 @@ class Skill:
         return frames.frames(self.name, as_params(self.name, params))
 
     def _observe_rated(self, sim: Simulator, params: ParamsLike = None) -> tuple[SkillObservation, float | None]:
-        """:meth:`observe` and, where frames were searched, the calibrated rating of the chosen one."""
+        """:meth:`observe` and, where frames were searched, the calibrated rating of the chosen one (with the
+        ratings of ``sim``'s sensor)."""
+        rated = self.ratings(getattr(sim, "sensor", None))
+        if rated is not self:
+            return rated._observe_rated(sim, params)
         seen = skill_observation(sim, self.name, as_params(self.name, params), self.n_points)
         if self.frame_search is None or not self.frame_search.searches(self.name, seen.params):
             return seen, None
@@ -147,19 +180,28 @@ class Skill:
         return self._searched
 
     def success_probability(self, sim: Simulator, params: ParamsLike = None) -> float:
-        """Predicted probability that ``execute(sim, params)`` succeeds now (no physics is run)."""
+        """Predicted probability that ``execute(sim, params)`` succeeds now (no physics is run), rated with the
+        ratings of ``sim``'s sensor."""
+        rated = self.ratings(getattr(sim, "sensor", None))
+        if rated is not self:
+            return rated.success_probability(sim, params)
         if self.searched_model is not None:
             seen = skill_observation(sim, self.name, as_params(self.name, params), self.n_points)
             return float(self.searched_model.predict(seen.obs))
         seen, p = self._observe_rated(sim, params)
         return float(self.success_model.predict(seen.obs)) if p is None else p
 
-    def success_probability_obs(self, obs: np.ndarray, parameterised: bool = True) -> np.ndarray:
+    def success_probability_obs(self, obs: np.ndarray, parameterised: bool = True,
+                                sensor: str | None = None) -> np.ndarray:
         """Predicted P(success) for observations ``(N, 9)`` or ``(B, N, 9)`` built in the goal frame
         (:func:`primitives.training.env.observe_cloud`), all with a parameter or all without; with a frame search, the
         searched success model's answer, or without one the calibrated rating of the best free frame (for the
         seed's objective a lower bound where the search has stand-ins: rating those needs the object and its
-        resting state, which an observation does not carry; :meth:`success_probability` rates them)."""
+        resting state, which an observation does not carry; :meth:`success_probability` rates them).
+        ``sensor``: the sensor whose clouds the observations were built from (default: the policy's)."""
+        rated = self.ratings(sensor)
+        if rated is not self:
+            return rated.success_probability_obs(obs, parameterised)
         if self.searched_model is not None:
             return self.searched_model.predict(obs)
         frames = self.frames({} if parameterised else None)
@@ -170,10 +212,14 @@ class Skill:
         return self.frame_search.calibrate(p.reshape(*obs.shape[:-2], len(frames)).max(axis=-1), parameterised)
 
 
-    def success_spread_obs(self, obs: np.ndarray, parameterised: bool = True) -> np.ndarray:
+    def success_spread_obs(self, obs: np.ndarray, parameterised: bool = True,
+                           sensor: str | None = None) -> np.ndarray:
         """How much the success model's members disagree on the ratings :meth:`success_probability_obs` gives
         (:meth:`primitives.success_model.SuccessModel.spread`): the searched success model's where the skill has
         one, else the goal-frame model's on the goal frame. A planner can read it as the rating's uncertainty."""
+        rated = self.ratings(sensor)
+        if rated is not self:
+            return rated.success_spread_obs(obs, parameterised)
         model = self.searched_model if self.searched_model is not None else self.success_model
         return model.spread(obs)
 
@@ -194,6 +240,9 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
     optionally ``{name}_frames.json`` and ``{name}_success_searched.pt``, all fitted together), whose files then
     stand in for the shipped ones, e.g. a candidate set under ``weights/candidates/``. A folder without
     ``{name}.pt`` leaves that skill on the shipped files. Not combined with ``weights`` or ``success_weights``.
+    With the shipped files or a ``weights_dir``, a subfolder named after a sensor (``cameras/``) that holds
+    ``{name}_success.pt`` (and optionally ``{name}_frames.json``, ``{name}_success_searched.pt``) gives the skill
+    ratings for that sensor's clouds (:meth:`Skill.ratings`).
     """
     if name not in SKILLS:
         raise InputError(f"unknown skill {name!r}; expected one of {SKILLS}")
@@ -219,8 +268,19 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
         raise InputError(f"frame_search must be True, False or a FrameSearch, got {frame_search!r}")
     searched_path = directory / f"{name}_success_searched.pt"  # trained on that skill's frame-searched outcomes
     searched_weights = searched_path if searched and shipped and searched_path.exists() else None
-    return Skill(name, load_policy(weights, name), success_weights=success_weights, frame_search=frame_search,
-                 searched_weights=searched_weights)
+    policy = load_policy(weights, name)
+    by_sensor = {}
+    if shipped:  # ratings of the same policy fitted to other sensors' clouds, in weights/{sensor}/
+        for sensor in SENSORS:
+            folder = directory / sensor
+            if sensor != policy.sensor and (folder / f"{name}_success.pt").exists():
+                searched_path = folder / f"{name}_success_searched.pt"
+                by_sensor[sensor] = Skill(name, policy, success_weights=folder / f"{name}_success.pt",
+                                          frame_search=shipped_frame_search(name, folder),
+                                          searched_weights=searched_path if searched and searched_path.exists()
+                                          else None)
+    return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
+                 searched_weights=searched_weights, ratings_by_sensor=by_sensor)
 
 
 def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[SkillName, Skill]:

@@ -186,13 +186,14 @@ class SuccessModel:
         return out[0] if single else out
 
 
-def load_success_net(skill: str, path: str | os.PathLike | None = None) -> SuccessNet:
-    """A success net from ``path`` or the shipped ``weights/{skill}_success.pt``.
+def load_success_net(skill: str, path: str | os.PathLike | None = None, sensor: str | None = None) -> SuccessNet:
+    """A success net from ``path`` or the shipped ``weights/{skill}_success.pt`` (fitted to ``sensor``'s clouds where
+    one is shipped for it: :func:`primitives.weights_file.ratings_dir`).
 
     Raises:
         WeightsError: missing, damaged or unsafe file, or one for another skill or kind of model.
     """
-    path = Path(path) if path else weights_file.SHIPPED_DIR / f"{skill}_success.pt"
+    path = Path(path) if path else weights_file.ratings_dir(skill, sensor) / f"{skill}_success.pt"
     payload, _ = weights_file.load(path, kind="success", skill=skill)
     try:
         net = SuccessNet.from_state_dict(payload["model"])

@@ -41,6 +41,17 @@ _WHAT = {"policy": "weights", "success": "success model", "checkpoint": "checkpo
 SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one place that knows where they live
 
 
+def ratings_dir(skill: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None) -> Path:
+    """The folder of ``skill``'s ratings (``{skill}_success.pt``, ``_frames.json``, ``_success_searched.pt``) fitted to
+    ``sensor``'s clouds: ``{weights_dir}/{sensor}/`` where it holds ``{skill}_success.pt``, else ``weights_dir``
+    itself, whose ratings are for the sensor the policy beside them was trained on. ``weights_dir``: by default the
+    shipped weights."""
+    base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
+    if sensor is not None and (base / sensor / f"{skill}_success.pt").exists():
+        return base / sensor
+    return base
+
+
 def to_storable(value: Any) -> Any:
     """``value`` with every NumPy array and scalar turned into a tensor or a Python number (recursively)."""
     if isinstance(value, np.ndarray):

@@ -12,6 +12,7 @@ import torch
 
 import affordplan as ap
 from affordplan.errors import InputError, ReachabilityError
+from affordplan.sim.sensor import SENSORS
 from primitives import load_skill, rewards, weights_file
 from primitives import skills as skills_module
 from primitives.networks import HybridActorCritic
@@ -99,8 +100,15 @@ def test_the_arm_sees_a_wall_over_a_pre_contact_point(cube):
 
 # ----------------------------------------------------------------------------- a folder of weights
 def _copy_skill_files(name: str, folder, files=("{}.pt", "{}_success.pt", "{}_frames.json", "{}_success_searched.pt")):
+    """The shipped files of skill ``name``, and its ratings for other sensors' clouds, into ``folder``."""
     for pattern in files:
         shutil.copyfile(skills_module.WEIGHTS_DIR / pattern.format(name), folder / pattern.format(name))
+    for sensor in SENSORS:
+        for pattern in files[1:]:
+            source = skills_module.WEIGHTS_DIR / sensor / pattern.format(name)
+            if source.exists():
+                (folder / sensor).mkdir(exist_ok=True)
+                shutil.copyfile(source, folder / sensor / pattern.format(name))
 
 
 def test_a_weights_folder_stands_in_for_the_shipped_files_and_rates_and_acts_the_same(tmp_path, cube):
@@ -186,3 +194,63 @@ def test_shipped_weights_load_offline_and_act(name):
     assert np.all(np.isfinite(contact)) and np.all(np.abs(motion) <= 1.0)
     again = load_skill(name).act(ap.Simulator(ap.load_object("cube"), seed=3))
     assert np.array_equal(again[0], contact) and np.array_equal(again[1], motion)  # deterministic
+
+
+# ----------------------------------------------------------------------------- ratings per sensor
+def _own_ratings_only(skill: skills_module.Skill) -> skills_module.Skill:
+    """``skill`` with the ratings shipped beside its policy alone (those fitted to the policy's own sensor)."""
+    return skills_module.Skill(skill.name, skill.model, success_weights=skill._success_weights,
+                               frame_search=skill.frame_search, searched_weights=skill._searched_weights)
+
+
+def _rated(skill: skills_module.Skill, cube, sensor: str, params) -> tuple[float, np.ndarray]:
+    """``skill``'s rating of ``params`` and its contact, on a fresh simulator of ``sensor`` in one fixed state."""
+    sim = ap.Simulator(cube, seed=3, sensor=sensor)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    p = skill.success_probability(sim, params)
+    sim = ap.Simulator(cube, seed=3, sensor=sensor)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    return p, skill.act(sim, params)[0]
+
+
+def test_a_skill_rates_and_picks_with_the_ratings_fitted_to_its_simulators_sensor(cube):
+    push = load_skill("push")  # push's ratings are shipped for its policy's sensor and, in cameras/, for cameras
+    assert push.sensor == "surface" and push.rated_sensors == ("surface", "cameras")
+    cameras = push.ratings("cameras")
+    assert cameras.model is push.model and cameras._success_weights == skills_module.WEIGHTS_DIR / "cameras" / \
+        "push_success.pt" and cameras.frame_search != push.frame_search
+    assert push.ratings("surface") is push and push.ratings(None) is push
+    own = _own_ratings_only(push)
+    for params in ({"direction": 0.7}, None):
+        p, contact = _rated(push, cube, "cameras", params)
+        p_cameras, contact_cameras = _rated(cameras, cube, "cameras", params)
+        assert p == pytest.approx(p_cameras) and np.allclose(contact, contact_cameras)
+        assert p != pytest.approx(_rated(own, cube, "cameras", params)[0], abs=1e-3)  # the other files' rating
+        p, contact = _rated(push, cube, "surface", params)  # a surface cloud: the files beside the policy
+        p_own, contact_own = _rated(own, cube, "surface", params)
+        assert p == pytest.approx(p_own) and np.allclose(contact, contact_own)
+    sim = ap.Simulator(cube, seed=3)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    obs = push.observe(sim, {"direction": 0.0}).obs[None]
+    np.testing.assert_allclose(push.success_probability_obs(obs, sensor="cameras"),
+                               cameras.success_probability_obs(obs))
+    np.testing.assert_allclose(push.success_probability_obs(obs), own.success_probability_obs(obs))
+    np.testing.assert_allclose(push.success_spread_obs(obs, sensor="cameras"), cameras.success_spread_obs(obs))
+
+
+def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path):
+    _copy_skill_files("push", tmp_path, files=("{}.pt", "{}_success.pt"))
+    assert load_skill("push", weights_dir=tmp_path).rated_sensors == ("surface", "cameras")
+    shutil.rmtree(tmp_path / "cameras")
+    (tmp_path / "cameras").mkdir()  # a folder without a success model gives no ratings
+    shutil.copyfile(skills_module.WEIGHTS_DIR / "push_frames.json", tmp_path / "cameras" / "push_frames.json")
+    push = load_skill("push", weights_dir=tmp_path)
+    assert push.rated_sensors == ("surface",) and push.ratings("cameras") is push
+    assert load_skill("spin").rated_sensors == ("surface",)  # none shipped for cameras: its own serve every cloud
+    assert load_skill("push", frame_search=False).rated_sensors == ("surface",)  # given files: those alone
+
+
+def test_ratings_for_another_policy_are_refused():
+    push, spin = load_skill("push"), load_skill("spin")
+    with pytest.raises(InputError, match="same policy"):
+        skills_module.Skill("push", push.model, ratings_by_sensor={"cameras": skills_module.Skill("push", spin.model)})

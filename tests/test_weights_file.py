@@ -84,3 +84,15 @@ def test_every_shipped_file_carries_metadata():
         kind = "success" if "_success" in path.stem else "policy"
         _, meta = weights_file.load(path, kind=kind, skill=path.stem.split("_")[0])
         assert meta["format"] == weights_file.FORMAT
+
+
+def test_ratings_dir_is_the_sensors_subfolder_where_it_holds_a_success_model(tmp_path):
+    (tmp_path / "cameras").mkdir()
+    (tmp_path / "cameras" / "push_frames.json").write_text("{}")
+    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path  # no success model there
+    (tmp_path / "cameras" / "push_success.pt").write_bytes(b"")
+    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path / "cameras"
+    assert weights_file.ratings_dir("spin", "cameras", tmp_path) == tmp_path
+    assert weights_file.ratings_dir("push", None, tmp_path) == tmp_path
+    assert weights_file.ratings_dir("push", "cameras") == weights_file.SHIPPED_DIR / "cameras"  # shipped for push
+    assert weights_file.ratings_dir("roll", "cameras") == weights_file.SHIPPED_DIR

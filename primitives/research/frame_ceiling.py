@@ -175,8 +175,8 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
     :func:`primitives.training.evaluate.object_list` takes (e.g. ``"housekeep:validation"``), the starts then
     cycling through its objects; ``sensor``: the clouds the policy and the ratings see."""
     policy = load_policy(weights, skill)
-    predict = SuccessModel(policy, load_success_net(skill, model)).predict
-    search = load_frame_search(skill, frames)
+    predict = SuccessModel(policy, load_success_net(skill, model, sensor)).predict
+    search = load_frame_search(skill, frames, sensor)
     p_params = 1.0 if params == "random" else 0.0
     if objects == "random":
         env, keys = PrimitiveEnv(held_out_config(skill, p_params, sensor), seed=seed), [None] * starts

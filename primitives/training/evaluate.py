@@ -132,14 +132,14 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
 
     ``p_params``: the share of trials that ask for a random parameter (0: the seed's objective; 1:
     every trial parameterised, judged by the parameterised criterion).
-    ``frame_search``: act in the free goal frame the success model (``success_weights``, the shipped one by
-    default) rates likeliest (:mod:`primitives.frames`), and record its calibrated ratings.
+    ``frame_search``: act in the free goal frame the success model (``success_weights``; by default the shipped
+    one for ``sensor``'s clouds) rates likeliest (:mod:`primitives.frames`), and record its calibrated ratings.
     """
     predict = None
     if frame_search is not None:
         from primitives.training.success import SuccessModel, load_success_net
 
-        predict = SuccessModel(model, load_success_net(primitive, success_weights)).predict
+        predict = SuccessModel(model, load_success_net(primitive, success_weights, sensor)).predict
     if objects == "random":
         cfg = held_out_config(primitive, p_params, sensor)
         plan = [None] * trials
@@ -282,7 +282,7 @@ def _frame_search(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     if args.frames == "shipped":
         from primitives.skills import shipped_frame_search
 
-        search = shipped_frame_search(args.primitive)
+        search = shipped_frame_search(args.primitive, sensor=args.sensor)
         if search is None:
             parser.error(f"no frame search is shipped for {args.primitive}")
         return search

@@ -782,7 +782,7 @@ def _run(args: argparse.Namespace) -> int:
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
         return 0
-    net = load_success_net(args.skill, args.model)
+    net = load_success_net(args.skill, args.model, sensor=args.sensor)  # by default the ratings for those clouds
     model = SuccessModel(policy, net)
     if args.frames is not None:
         return _evaluate_frames(args, model)
@@ -882,7 +882,7 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
     """``evaluate --frames``: the skill acting with a frame search on unseen objects, judged by two raters on the
     same rollouts: the calibrated rating of the chosen frame, and the searched success model, which rates the
     searched skill from the goal frame alone (the shipped ``{skill}_success_searched.pt``, or ``--searched``)."""
-    search = load_frame_search(args.skill, args.frames)
+    search = load_frame_search(args.skill, args.frames, sensor=args.sensor)
     rating, data = collect_frame_search(model, args.skill, args.rollouts, search, args.objects, n_objects=200,
                                         seed=args.seed, progress=not args.json, sensor=args.sensor)
     success, par = data.success, data.parameterised
@@ -895,7 +895,7 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
                   query_ms=1e3 * bench_query(model.predict, reframe_obs(obs, frames)),
                   frames_per_query=len(frames))
     searched_paths = ([Path(path) for path in args.searched] if args.searched
-                      else [weights_file.SHIPPED_DIR / f"{args.skill}_success_searched.pt"])
+                      else [weights_file.ratings_dir(args.skill, args.sensor) / f"{args.skill}_success_searched.pt"])
     obs_all, decision = torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)
     for i, searched_path in enumerate(searched_paths):
         if not (args.searched or searched_path.exists()):
