@@ -95,4 +95,4 @@ def test_ratings_dir_is_the_sensors_subfolder_where_it_holds_a_success_model(tmp
     assert weights_file.ratings_dir("spin", "cameras", tmp_path) == tmp_path
     assert weights_file.ratings_dir("push", None, tmp_path) == tmp_path
     assert weights_file.ratings_dir("push", "cameras") == weights_file.SHIPPED_DIR / "cameras"  # shipped for push
-    assert weights_file.ratings_dir("roll", "cameras") == weights_file.SHIPPED_DIR
+    assert weights_file.ratings_dir("spin", "cameras") == weights_file.SHIPPED_DIR  # none shipped for spin
