@@ -54,6 +54,7 @@ from primitives.params import SKILLS, ParamsLike, SkillName, as_params
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
+from primitives.weights_file import ratings_dir
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -266,21 +267,25 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
         frame_search = None
     elif not isinstance(frame_search, FrameSearch):
         raise InputError(f"frame_search must be True, False or a FrameSearch, got {frame_search!r}")
-    searched_path = directory / f"{name}_success_searched.pt"  # trained on that skill's frame-searched outcomes
-    searched_weights = searched_path if searched and shipped and searched_path.exists() else None
     policy = load_policy(weights, name)
     by_sensor = {}
-    if shipped:  # ratings of the same policy fitted to other sensors' clouds, in weights/{sensor}/
+    if shipped:  # ratings of the same policy fitted to other sensors' clouds, in {directory}/{sensor}/
         for sensor in SENSORS:
-            folder = directory / sensor
-            if sensor != policy.sensor and (folder / f"{name}_success.pt").exists():
-                searched_path = folder / f"{name}_success_searched.pt"
+            folder = ratings_dir(name, sensor, directory)
+            if sensor != policy.sensor and folder != directory:
                 by_sensor[sensor] = Skill(name, policy, success_weights=folder / f"{name}_success.pt",
                                           frame_search=shipped_frame_search(name, folder),
-                                          searched_weights=searched_path if searched and searched_path.exists()
-                                          else None)
+                                          searched_weights=_searched_beside(name, folder, searched))
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
-                 searched_weights=searched_weights, ratings_by_sensor=by_sensor)
+                 searched_weights=_searched_beside(name, directory, searched and shipped),
+                 ratings_by_sensor=by_sensor)
+
+
+def _searched_beside(name: SkillName, folder: Path, wanted: bool) -> Path | None:
+    """``{folder}/{name}_success_searched.pt`` (trained on the skill's frame-searched outcomes) where it is
+    ``wanted`` and exists, else ``None``."""
+    path = folder / f"{name}_success_searched.pt"
+    return path if wanted and path.exists() else None
 
 
 def load_skills(weights_dir: str | os.PathLike | None = None) -> dict[SkillName, Skill]:
