@@ -272,7 +272,7 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
     if shipped:  # ratings of the same policy fitted to other sensors' clouds, in {directory}/{sensor}/
         for sensor in SENSORS:
             folder = ratings_dir(name, sensor, directory)
-            if sensor != policy.sensor and folder != directory:
+            if folder != directory:  # ratings_dir: a subfolder only for a sensor other than the policy's own
                 by_sensor[sensor] = Skill(name, policy, success_weights=folder / f"{name}_success.pt",
                                           frame_search=shipped_frame_search(name, folder),
                                           searched_weights=_searched_beside(name, folder, searched))

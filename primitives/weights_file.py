@@ -43,13 +43,26 @@ SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one 
 
 def ratings_dir(skill: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None) -> Path:
     """The folder of ``skill``'s ratings (``{skill}_success.pt``, ``_frames.json``, ``_success_searched.pt``) fitted to
-    ``sensor``'s clouds: ``{weights_dir}/{sensor}/`` where it holds ``{skill}_success.pt``, else ``weights_dir``
-    itself, whose ratings are for the sensor the policy beside them was trained on. ``weights_dir``: by default the
-    shipped weights."""
+    ``sensor``'s clouds: ``{weights_dir}/{sensor}/`` where it holds ``{skill}_success.pt`` and the policy
+    ``{weights_dir}/{skill}.pt`` was trained on another sensor's clouds, else ``weights_dir`` itself, whose ratings
+    are for the sensor the policy beside them was trained on. ``weights_dir``: by default the shipped weights."""
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
-    if sensor is not None and (base / sensor / f"{skill}_success.pt").exists():
+    if sensor is not None and (base / sensor / f"{skill}_success.pt").exists() and policy_sensor(skill, base) != sensor:
         return base / sensor
     return base
+
+
+def policy_sensor(skill: str, weights_dir: str | os.PathLike | None = None) -> str | None:
+    """The sensor whose clouds the policy ``{weights_dir}/{skill}.pt`` was trained on (its metadata; ``"surface"``
+    for files stamped without one), or ``None`` where the folder holds no readable policy of ``skill``."""
+    path = (Path(weights_dir) if weights_dir is not None else SHIPPED_DIR) / f"{skill}.pt"
+    if not path.is_file():
+        return None
+    try:
+        _, meta = load(path, kind="policy", skill=skill)
+    except WeightsError:
+        return None
+    return str(meta.get("sensor", "surface"))
 
 
 def to_storable(value: Any) -> Any:

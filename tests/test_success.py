@@ -419,9 +419,11 @@ def test_a_contact_encoder_learns_round_trips_and_answers_as_its_stacked_form(tm
 
 
 @pytest.mark.parametrize("objects", ["test", "housekeep:unseen", "train+housekeep:unseen_class_thick",
-                                     "housekeep:training+housekeep:unseen_instance"])
+                                     "housekeep:training+housekeep:unseen_instance",
+                                     "train+housekeep/clamp_050_medium_clamp_M",
+                                     "some/where/clamp_050_medium_clamp_M.obj"])
 def test_fitting_refuses_held_out_objects_and_evaluating_takes_them(objects):
-    from primitives.training.success import check_objects
+    from primitives.training.env import check_objects
 
     with pytest.raises(InputError, match="held out"):
         check_objects(objects, fitting=True)
@@ -429,3 +431,12 @@ def test_fitting_refuses_held_out_objects_and_evaluating_takes_them(objects):
     check_objects("train+housekeep:training", fitting=True)
     with pytest.raises(InputError, match="housekeep split"):
         check_objects("housekeep:nope", fitting=False)
+
+
+def test_single_training_meshes_are_not_held_out():
+    from affordplan.objects import housekeep
+    from primitives.training.env import check_objects, held_out
+
+    name = housekeep.names("training")[0]
+    assert not held_out(f"housekeep/{name}") and not held_out("cube") and not held_out(f"meshes/{name}.obj")
+    check_objects(f"train+housekeep/{name}", fitting=True)

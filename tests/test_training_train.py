@@ -155,6 +155,10 @@ def test_a_bf16_update_is_the_float32_update_up_to_rounding():
     ("precision", "fp16", "--precision must be one of ('fp32', 'bf16'), got 'fp16'"),
     ("actor_delay", 0, "TrainConfig.actor_delay must be a whole number >= 1"),
     ("sim_cache", 0, "TrainConfig.sim_cache must be a whole number >= 1"),
+    # test objects never train a policy, whether a split or one mesh of it
+    ("objects", "train+housekeep:unseen", "housekeep:unseen is held out for evaluation"),
+    ("objects", "test", "test is held out for evaluation"),
+    ("objects", "housekeep/clamp_050_medium_clamp_M+train", "clamp_050_medium_clamp_M is held out for evaluation"),
 ])
 def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field, value, words):
 

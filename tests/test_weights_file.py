@@ -96,3 +96,16 @@ def test_ratings_dir_is_the_sensors_subfolder_where_it_holds_a_success_model(tmp
     assert weights_file.ratings_dir("push", None, tmp_path) == tmp_path
     assert weights_file.ratings_dir("push", "cameras") == weights_file.SHIPPED_DIR / "cameras"  # shipped for push
     assert weights_file.ratings_dir("spin", "cameras") == weights_file.SHIPPED_DIR  # none shipped for spin
+
+
+def test_ratings_dir_is_the_policys_own_folder_for_the_sensor_it_was_trained_on(tmp_path):
+    (tmp_path / "cameras").mkdir()
+    (tmp_path / "cameras" / "push_success.pt").write_bytes(b"")  # stale camera ratings beside...
+    policy = {"model": {"w": torch.zeros(1)}}
+    weights_file.save(tmp_path / "push.pt", policy, weights_file.make_meta("push", "policy", sensor="cameras"))
+    assert weights_file.policy_sensor("push", tmp_path) == "cameras"
+    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path  # ...a camera-trained policy: unused
+    weights_file.save(tmp_path / "push.pt", policy, weights_file.make_meta("push", "policy", sensor="surface"))
+    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path / "cameras"
+    assert weights_file.policy_sensor("roll", tmp_path) is None  # no policy there
+    assert weights_file.policy_sensor("push") == "surface"  # the shipped policies saw the surface sample

@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
@@ -113,6 +114,29 @@ def object_groups(objects: str | tuple[str, ...], n_objects: int) -> list[list]:
         else:  # a catalogue name, housekeep/NAME or a mesh path
             groups.append([spec])
     return groups
+
+
+def held_out(spec: str) -> bool:
+    """Whether one ``+``-part of an ``--objects`` is held out for evaluation: the procedural test split, any of
+    HACMan's unseen household splits (``housekeep:unseen``, ``unseen_instance``, ``unseen_class`` and their
+    ``_thick`` lists), or one of their meshes named alone (``housekeep/NAME``, or its file's path)."""
+    if spec == "test" or spec.startswith("housekeep:unseen"):
+        return True
+    unseen = set(housekeep.names("unseen"))
+    if spec.startswith(housekeep.PREFIX):
+        return spec.removeprefix(housekeep.PREFIX) in unseen
+    return Path(spec).suffix.lower() == ".obj" and Path(spec).stem in unseen
+
+
+def check_objects(objects: str, fitting: bool) -> None:
+    """Raise :class:`InputError` for an ``--objects`` naming no objects, or, when ``fitting`` (a policy, a model or
+    a calibration is fitted on them), naming held-out objects (:func:`held_out`): test objects are never trained,
+    tuned or selected on."""
+    object_groups(objects, 1)
+    held = [spec for spec in objects.split("+") if held_out(spec)]
+    if fitting and held:
+        raise InputError(f"--objects {objects}: {', '.join(held)} is held out for evaluation; fit on train, "
+                         "housekeep:training or housekeep:validation")
 
 
 def _lru(cache: OrderedDict, key, capacity: int, build: Callable[[], T], evict: Callable[[T], None] | None = None) -> T:

@@ -71,7 +71,7 @@ from primitives.success_model import (  # noqa: F401 (re-exported for training a
     load_success_net,
     member_input,
 )
-from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, object_groups
+from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.neighbours import neighbour_outcomes
 
 
@@ -798,23 +798,6 @@ def _run(args: argparse.Namespace) -> int:
         plot_reliability(p, data.success, args.plot, f"{args.skill} success model, {args.objects}, {args.sensor}")
     print(json.dumps(result, indent=2))
     return 0
-
-
-def held_out(spec: str) -> bool:
-    """Whether one ``+``-part of ``--objects`` is held out for evaluation: the procedural test split, or any of HACMan's
-    unseen household splits (``housekeep:unseen``, ``unseen_instance``, ``unseen_class`` and their ``_thick``
-    lists)."""
-    return spec == "test" or spec.startswith("housekeep:unseen")
-
-
-def check_objects(objects: str, fitting: bool) -> None:
-    """Raise :class:`InputError` for an ``--objects`` naming no objects, or, when ``fitting`` (a model or a
-    calibration is fitted on them), naming a held-out split: test objects are never trained, tuned or selected on."""
-    object_groups(objects, 1)
-    held = [spec for spec in objects.split("+") if held_out(spec)]
-    if fitting and held:
-        raise InputError(f"--objects {objects}: {', '.join(held)} is held out for evaluation; fit on train, "
-                         "housekeep:training or housekeep:validation")
 
 
 def _objects_args(args: argparse.Namespace) -> str:

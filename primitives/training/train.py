@@ -71,7 +71,7 @@ from affordplan.log import cli_logging
 from primitives import weights_file
 from primitives.networks import HybridActorCritic
 from primitives.training import checkpoint as ckpt
-from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv
+from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.hindsight import relabel
 from primitives.training.replay import ReplayBuffer
 from primitives.training.rollouts import BACKENDS, Exploration, act, import_ray, make_source, rss_mb
@@ -190,7 +190,8 @@ def _setting(name: str) -> str:
 
 def check_config(cfg: TrainConfig) -> None:
     """Raise :class:`InputError` for settings that cannot run: a count or budget out of range, a probability
-    outside [0, 1], NaN, missing ``--init`` weights, or a backend / workers / address combination."""
+    outside [0, 1], NaN, missing ``--init`` weights, a backend / workers / address combination, or ``--objects``
+    naming held-out objects (:func:`primitives.training.env.check_objects`)."""
     if cfg.primitive not in PRIMITIVES:
         raise InputError(f"unknown primitive {cfg.primitive!r}; expected one of {PRIMITIVES}")
     counts = dict(steps=(cfg.steps, 1), workers=(cfg.workers, 0), batch_size=(cfg.batch_size, 1),
@@ -220,6 +221,8 @@ def check_config(cfg: TrainConfig) -> None:
         raise InputError(f"--precision must be one of {PRECISIONS}, got {cfg.precision!r}")
     if cfg.p_scripted > 0.0 and cfg.primitive != "push":
         raise InputError(f"--p-scripted exists for push only (primitives.training.scripted), not {cfg.primitive}")
+    if isinstance(cfg.objects, str):
+        check_objects(cfg.objects, fitting=True)
 
 
 # ---------------------------------------------------------------------------- learning
