@@ -58,7 +58,7 @@ from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives import params as skill_params
 from primitives.observation import OBS_DIM, SkillObservation, observe_cloud
-from primitives.weights_file import ratings_dir
+from primitives.weights_file import rating_path
 
 if TYPE_CHECKING:
     from affordplan.sim import Simulator
@@ -262,8 +262,8 @@ def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None
                          sensor: str | None = None) -> FrameSearch | None:
     """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
     package's ``weights/``; for ``sensor``'s clouds where one was fitted to them,
-    :func:`primitives.weights_file.ratings_dir`), if any."""
-    path = ratings_dir(name, sensor, weights_dir) / f"{name}_frames.json"
+    :func:`primitives.weights_file.rating_path`), if any."""
+    path = rating_path(name, "frames", sensor, weights_dir)
     return FrameSearch.load(path) if path.exists() else None
 
 

@@ -54,7 +54,7 @@ from primitives.params import SKILLS, ParamsLike, SkillName, as_params
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
-from primitives.weights_file import ratings_dir
+from primitives.weights_file import rated_for, rating_path
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -241,9 +241,10 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
     optionally ``{name}_frames.json`` and ``{name}_success_searched.pt``, all fitted together), whose files then
     stand in for the shipped ones, e.g. a candidate set under ``weights/candidates/``. A folder without
     ``{name}.pt`` leaves that skill on the shipped files. Not combined with ``weights`` or ``success_weights``.
-    With the shipped files or a ``weights_dir``, a subfolder named after a sensor (``cameras/``) that holds
-    ``{name}_success.pt`` (and optionally ``{name}_frames.json``, ``{name}_success_searched.pt``) gives the skill
-    ratings for that sensor's clouds (:meth:`Skill.ratings`).
+    With the shipped files or a ``weights_dir``, a subfolder named after a sensor (``cameras/``) that holds any of
+    ``{name}_success.pt``, ``{name}_frames.json``, ``{name}_success_searched.pt`` refitted to that sensor's clouds
+    gives the skill ratings for them (:meth:`Skill.ratings`): those files, and the policy's own for the others
+    (:func:`primitives.weights_file.rating_path`).
     """
     if name not in SKILLS:
         raise InputError(f"unknown skill {name!r}; expected one of {SKILLS}")
@@ -269,13 +270,14 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
         raise InputError(f"frame_search must be True, False or a FrameSearch, got {frame_search!r}")
     policy = load_policy(weights, name)
     by_sensor = {}
-    if shipped:  # ratings of the same policy fitted to other sensors' clouds, in {directory}/{sensor}/
+    if shipped:  # ratings of the same policy refitted to other sensors' clouds, in {directory}/{sensor}/
         for sensor in SENSORS:
-            folder = ratings_dir(name, sensor, directory)
-            if folder != directory:  # ratings_dir: a subfolder only for a sensor other than the policy's own
-                by_sensor[sensor] = Skill(name, policy, success_weights=folder / f"{name}_success.pt",
-                                          frame_search=shipped_frame_search(name, folder),
-                                          searched_weights=_searched_beside(name, folder, searched))
+            if rated_for(name, sensor, directory):  # the others: the policy's own (rating_path)
+                searched_path = rating_path(name, "searched", sensor, directory)
+                by_sensor[sensor] = Skill(
+                    name, policy, success_weights=rating_path(name, "success", sensor, directory),
+                    frame_search=shipped_frame_search(name, directory, sensor),
+                    searched_weights=searched_path if searched and searched_path.exists() else None)
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
                  searched_weights=_searched_beside(name, directory, searched and shipped),
                  ratings_by_sensor=by_sensor)

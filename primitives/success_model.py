@@ -188,12 +188,12 @@ class SuccessModel:
 
 def load_success_net(skill: str, path: str | os.PathLike | None = None, sensor: str | None = None) -> SuccessNet:
     """A success net from ``path`` or the shipped ``weights/{skill}_success.pt`` (fitted to ``sensor``'s clouds where
-    one is shipped for it: :func:`primitives.weights_file.ratings_dir`).
+    one is shipped for it: :func:`primitives.weights_file.rating_path`).
 
     Raises:
         WeightsError: missing, damaged or unsafe file, or one for another skill or kind of model.
     """
-    path = Path(path) if path else weights_file.ratings_dir(skill, sensor) / f"{skill}_success.pt"
+    path = Path(path) if path else weights_file.rating_path(skill, "success", sensor)
     payload, _ = weights_file.load(path, kind="success", skill=skill)
     try:
         net = SuccessNet.from_state_dict(payload["model"])

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from affordplan.errors import WeightsError
+from affordplan.errors import InputError, WeightsError
 from affordplan.log import cli_logging
 from primitives.params import SKILLS
 
@@ -41,15 +41,38 @@ _WHAT = {"policy": "weights", "success": "success model", "checkpoint": "checkpo
 SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one place that knows where they live
 
 
-def ratings_dir(skill: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None) -> Path:
-    """The folder of ``skill``'s ratings (``{skill}_success.pt``, ``_frames.json``, ``_success_searched.pt``) fitted to
-    ``sensor``'s clouds: ``{weights_dir}/{sensor}/`` where it holds ``{skill}_success.pt`` and the policy
-    ``{weights_dir}/{skill}.pt`` was trained on another sensor's clouds, else ``weights_dir`` itself, whose ratings
-    are for the sensor the policy beside them was trained on. ``weights_dir``: by default the shipped weights."""
+RATINGS = ("success", "frames", "searched")  # a policy's ratings: goal-frame model, frame calibration, searched model
+
+
+def rating_name(skill: str, rating: str) -> str:
+    """The file name of one of ``skill``'s :data:`RATINGS`."""
+    names = {"success": f"{skill}_success.pt", "frames": f"{skill}_frames.json",
+             "searched": f"{skill}_success_searched.pt"}
+    if rating not in names:
+        raise InputError(f"unknown rating {rating!r}; one of {RATINGS}")
+    return names[rating]
+
+
+def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None
+                ) -> Path:
+    """The file of ``skill``'s ``rating`` (:data:`RATINGS`) for ``sensor``'s clouds.
+
+    A policy's ratings beside it (``{weights_dir}/{skill}_success.pt``, ``_frames.json``, ``_success_searched.pt``)
+    fit the sensor it was trained on. ``{weights_dir}/{sensor}/`` may hold any of them refitted to another sensor's
+    clouds: that file where it exists and the policy was trained on another sensor, else the one beside the policy
+    (whether or not it exists). ``weights_dir``: by default the shipped weights.
+    """
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
-    if sensor is not None and (base / sensor / f"{skill}_success.pt").exists() and policy_sensor(skill, base) != sensor:
-        return base / sensor
-    return base
+    name = rating_name(skill, rating)
+    if sensor is not None and (base / sensor / name).exists() and policy_sensor(skill, base) != sensor:
+        return base / sensor / name
+    return base / name
+
+
+def rated_for(skill: str, sensor: str, weights_dir: str | os.PathLike | None = None) -> bool:
+    """Whether any of ``skill``'s ratings was refitted to ``sensor``'s clouds (:func:`rating_path`)."""
+    base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
+    return any(rating_path(skill, rating, sensor, base).parent != base for rating in RATINGS)
 
 
 def policy_sensor(skill: str, weights_dir: str | os.PathLike | None = None) -> str | None:

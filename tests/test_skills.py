@@ -238,14 +238,29 @@ def test_a_skill_rates_and_picks_with_the_ratings_fitted_to_its_simulators_senso
     np.testing.assert_allclose(push.success_spread_obs(obs, sensor="cameras"), cameras.success_spread_obs(obs))
 
 
-def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path):
+def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, cube):
     _copy_skill_files("push", tmp_path, files=("{}.pt", "{}_success.pt"))
     assert load_skill("push", weights_dir=tmp_path).rated_sensors == ("surface", "cameras")
     shutil.rmtree(tmp_path / "cameras")
-    (tmp_path / "cameras").mkdir()  # a folder without a success model gives no ratings
-    shutil.copyfile(skills_module.WEIGHTS_DIR / "push_frames.json", tmp_path / "cameras" / "push_frames.json")
+    (tmp_path / "cameras").mkdir()  # an empty folder gives no ratings
     push = load_skill("push", weights_dir=tmp_path)
     assert push.rated_sensors == ("surface",) and push.ratings("cameras") is push
+    # one rating refitted: the camera ratings take it, and the policy's own files for the others
+    for own in ("push_frames.json", "push_success_searched.pt"):
+        shutil.copyfile(skills_module.WEIGHTS_DIR / own, tmp_path / own)
+    shutil.copyfile(skills_module.WEIGHTS_DIR / "cameras" / "push_success_searched.pt",
+                    tmp_path / "cameras" / "push_success_searched.pt")
+    push = load_skill("push", weights_dir=tmp_path)
+    cameras = push.ratings("cameras")
+    assert push.rated_sensors == ("surface", "cameras") and cameras is not push
+    assert cameras._searched_weights == tmp_path / "cameras" / "push_success_searched.pt"
+    assert cameras._success_weights == push._success_weights == tmp_path / "push_success.pt"
+    assert cameras.frame_search == push.frame_search is not None
+    sim = ap.Simulator(cube, seed=3)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    obs = push.observe(sim, {"direction": 0.0}).obs[None]  # rated by the searched model: the camera one differs
+    assert push.success_probability_obs(obs, sensor="cameras") != pytest.approx(push.success_probability_obs(obs),
+                                                                                abs=1e-3)
     assert load_skill("spin").rated_sensors == ("surface",)  # none shipped for cameras: its own serve every cloud
     assert load_skill("push", frame_search=False).rated_sensors == ("surface",)  # given files: those alone
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import torch
 
-from affordplan.errors import WeightsError
+from affordplan.errors import InputError, WeightsError
 from primitives import weights_file
 from primitives.networks import HybridActorCritic
 from primitives.policy import load_policy
@@ -86,26 +86,31 @@ def test_every_shipped_file_carries_metadata():
         assert meta["format"] == weights_file.FORMAT
 
 
-def test_ratings_dir_is_the_sensors_subfolder_where_it_holds_a_success_model(tmp_path):
+def test_a_rating_comes_from_the_sensors_subfolder_where_it_is_there(tmp_path):
     (tmp_path / "cameras").mkdir()
     (tmp_path / "cameras" / "push_frames.json").write_text("{}")
-    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path  # no success model there
-    (tmp_path / "cameras" / "push_success.pt").write_bytes(b"")
-    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path / "cameras"
-    assert weights_file.ratings_dir("spin", "cameras", tmp_path) == tmp_path
-    assert weights_file.ratings_dir("push", None, tmp_path) == tmp_path
-    assert weights_file.ratings_dir("push", "cameras") == weights_file.SHIPPED_DIR / "cameras"  # shipped for push
-    assert weights_file.ratings_dir("spin", "cameras") == weights_file.SHIPPED_DIR  # none shipped for spin
+    assert weights_file.rating_path("push", "frames", "cameras", tmp_path) == tmp_path / "cameras" / "push_frames.json"
+    assert weights_file.rating_path("push", "success", "cameras", tmp_path) == tmp_path / "push_success.pt"  # not there
+    assert weights_file.rating_path("push", "frames", None, tmp_path) == tmp_path / "push_frames.json"
+    assert weights_file.rating_path("push", "frames", "surface", tmp_path) == tmp_path / "push_frames.json"
+    assert weights_file.rated_for("push", "cameras", tmp_path)
+    assert not weights_file.rated_for("spin", "cameras", tmp_path)
+    assert weights_file.rating_path("push", "success", "cameras") == weights_file.SHIPPED_DIR / "cameras" / \
+        "push_success.pt"  # shipped for push
+    assert weights_file.rating_path("spin", "success", "cameras") == weights_file.SHIPPED_DIR / "spin_success.pt"
+    with pytest.raises(InputError, match="unknown rating"):
+        weights_file.rating_path("push", "policy")
 
 
-def test_ratings_dir_is_the_policys_own_folder_for_the_sensor_it_was_trained_on(tmp_path):
+def test_ratings_are_the_policys_own_for_the_sensor_it_was_trained_on(tmp_path):
     (tmp_path / "cameras").mkdir()
     (tmp_path / "cameras" / "push_success.pt").write_bytes(b"")  # stale camera ratings beside...
     policy = {"model": {"w": torch.zeros(1)}}
     weights_file.save(tmp_path / "push.pt", policy, weights_file.make_meta("push", "policy", sensor="cameras"))
     assert weights_file.policy_sensor("push", tmp_path) == "cameras"
-    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path  # ...a camera-trained policy: unused
+    assert weights_file.rating_path("push", "success", "cameras", tmp_path) == tmp_path / "push_success.pt"  # unused
+    assert not weights_file.rated_for("push", "cameras", tmp_path)
     weights_file.save(tmp_path / "push.pt", policy, weights_file.make_meta("push", "policy", sensor="surface"))
-    assert weights_file.ratings_dir("push", "cameras", tmp_path) == tmp_path / "cameras"
+    assert weights_file.rating_path("push", "success", "cameras", tmp_path) == tmp_path / "cameras" / "push_success.pt"
     assert weights_file.policy_sensor("roll", tmp_path) is None  # no policy there
     assert weights_file.policy_sensor("push") == "surface"  # the shipped policies saw the surface sample

@@ -878,7 +878,7 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
                   query_ms=1e3 * bench_query(model.predict, reframe_obs(obs, frames)),
                   frames_per_query=len(frames))
     searched_paths = ([Path(path) for path in args.searched] if args.searched
-                      else [weights_file.ratings_dir(args.skill, args.sensor) / f"{args.skill}_success_searched.pt"])
+                      else [weights_file.rating_path(args.skill, "searched", args.sensor)])
     obs_all, decision = torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)
     for i, searched_path in enumerate(searched_paths):
         if not (args.searched or searched_path.exists()):
