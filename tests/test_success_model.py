@@ -68,10 +68,14 @@ def test_the_lever_arm_feature_is_the_motion_lines_distance_from_the_centroid():
     assert torch.isfinite(still).all()
 
 
-def test_a_model_fitted_before_the_lever_arm_reads_only_its_thirteen_features():
-    from primitives.skills import load_skill
+def test_a_model_fitted_before_the_lever_arm_reads_only_its_thirteen_features(tmp_path):
+    from primitives import weights_file
 
-    net = load_skill("roll").success_model.net  # roll's shipped files predate the lever arm
+    # a file fitted before the lever arm (as roll's were until 0.24): its head reads 13 decision features
+    old = success_model.SuccessNet(members=2, n_decision=13)
+    weights_file.save(tmp_path / "old.pt", {"model": old.state_dict(), "info": {}},
+                      weights_file.make_meta("roll", "success"))
+    net = success_model.load_success_net("roll", tmp_path / "old.pt")
     assert net.n_decision == 13
     obs = torch.randn(3, 256, 9) * 0.03
     dec = torch.randn(3, success_model.N_DECISION)
