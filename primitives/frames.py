@@ -259,11 +259,11 @@ class FrameSearch:
 
 
 def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None,
-                         sensor: str | None = None) -> FrameSearch | None:
+                         sensor: str | None = None, *, trained_on: str | None = None) -> FrameSearch | None:
     """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
     package's ``weights/``; for ``sensor``'s clouds where one was fitted to them,
-    :func:`primitives.weights_file.rating_path`), if any."""
-    path = rating_path(name, "frames", sensor, weights_dir)
+    :func:`primitives.weights_file.rating_path`, ``trained_on`` as there), if any."""
+    path = rating_path(name, "frames", sensor, weights_dir, trained_on=trained_on)
     return FrameSearch.load(path) if path.exists() else None
 
 

@@ -54,7 +54,7 @@ from primitives.params import SKILLS, ParamsLike, SkillName, as_params
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
-from primitives.weights_file import rated_for, rating_path
+from primitives.weights_file import rated_for, rating_name, rating_path
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -272,11 +272,12 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
     by_sensor = {}
     if shipped:  # ratings of the same policy refitted to other sensors' clouds, in {directory}/{sensor}/
         for sensor in SENSORS:
-            if rated_for(name, sensor, directory):  # the others: the policy's own (rating_path)
-                searched_path = rating_path(name, "searched", sensor, directory)
+            own = policy.sensor  # known here: the rules below need not read it from the policy's file again
+            if rated_for(name, sensor, directory, trained_on=own):  # the others: the policy's own (rating_path)
+                searched_path = rating_path(name, "searched", sensor, directory, trained_on=own)
                 by_sensor[sensor] = Skill(
-                    name, policy, success_weights=rating_path(name, "success", sensor, directory),
-                    frame_search=shipped_frame_search(name, directory, sensor),
+                    name, policy, success_weights=rating_path(name, "success", sensor, directory, trained_on=own),
+                    frame_search=shipped_frame_search(name, directory, sensor, trained_on=own),
                     searched_weights=searched_path if searched and searched_path.exists() else None)
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
                  searched_weights=_searched_beside(name, directory, searched and shipped),
@@ -286,7 +287,7 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
 def _searched_beside(name: SkillName, folder: Path, wanted: bool) -> Path | None:
     """``{folder}/{name}_success_searched.pt`` (trained on the skill's frame-searched outcomes) where it is
     ``wanted`` and exists, else ``None``."""
-    path = folder / f"{name}_success_searched.pt"
+    path = folder / rating_name(name, "searched")
     return path if wanted and path.exists() else None
 
 

@@ -53,26 +53,34 @@ def rating_name(skill: str, rating: str) -> str:
     return names[rating]
 
 
-def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None
-                ) -> Path:
+def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None,
+                *, trained_on: str | None = None) -> Path:
     """The file of ``skill``'s ``rating`` (:data:`RATINGS`) for ``sensor``'s clouds.
 
     A policy's ratings beside it (``{weights_dir}/{skill}_success.pt``, ``_frames.json``, ``_success_searched.pt``)
     fit the sensor it was trained on. ``{weights_dir}/{sensor}/`` may hold any of them refitted to another sensor's
     clouds: that file where it exists and the policy was trained on another sensor, else the one beside the policy
-    (whether or not it exists). ``weights_dir``: by default the shipped weights.
+    (whether or not it exists). ``weights_dir``: by default the shipped weights. ``trained_on``: the policy's sensor
+    where the caller has it (a loaded policy's ``sensor``); otherwise it is read from the policy's file when needed.
     """
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
     name = rating_name(skill, rating)
-    if sensor is not None and (base / sensor / name).exists() and policy_sensor(skill, base) != sensor:
-        return base / sensor / name
+    if sensor is not None and (base / sensor / name).exists():
+        own = trained_on if trained_on is not None else policy_sensor(skill, base)
+        if own != sensor:
+            return base / sensor / name
     return base / name
 
 
-def rated_for(skill: str, sensor: str, weights_dir: str | os.PathLike | None = None) -> bool:
-    """Whether any of ``skill``'s ratings was refitted to ``sensor``'s clouds (:func:`rating_path`)."""
+def rated_for(skill: str, sensor: str, weights_dir: str | os.PathLike | None = None, *,
+              trained_on: str | None = None) -> bool:
+    """Whether any of ``skill``'s ratings was refitted to ``sensor``'s clouds (:func:`rating_path`; ``trained_on``
+    as there)."""
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
-    return any(rating_path(skill, rating, sensor, base).parent != base for rating in RATINGS)
+    if not any((base / sensor / rating_name(skill, rating)).exists() for rating in RATINGS):
+        return False
+    own = trained_on if trained_on is not None else policy_sensor(skill, base)
+    return any(rating_path(skill, rating, sensor, base, trained_on=own).parent != base for rating in RATINGS)
 
 
 def policy_sensor(skill: str, weights_dir: str | os.PathLike | None = None) -> str | None:

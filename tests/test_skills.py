@@ -238,6 +238,17 @@ def test_a_skill_rates_and_picks_with_the_ratings_fitted_to_its_simulators_senso
     np.testing.assert_allclose(push.success_spread_obs(obs, sensor="cameras"), cameras.success_spread_obs(obs))
 
 
+def test_loading_a_skill_takes_its_policys_sensor_from_the_loaded_policy(monkeypatch):
+    from primitives import weights_file
+
+    def reread(*args, **kwargs):
+        raise AssertionError("the policy's file was read again for its sensor")
+
+    monkeypatch.setattr(weights_file, "policy_sensor", reread)
+    push = load_skill("push")  # its camera ratings resolved with the loaded policy's sensor
+    assert push.rated_sensors == ("surface", "cameras")
+
+
 def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, cube):
     _copy_skill_files("push", tmp_path, files=("{}.pt", "{}_success.pt"))
     assert load_skill("push", weights_dir=tmp_path).rated_sensors == ("surface", "cameras")

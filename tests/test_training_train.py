@@ -159,6 +159,8 @@ def test_a_bf16_update_is_the_float32_update_up_to_rounding():
     ("objects", "train+housekeep:unseen", "housekeep:unseen is held out for evaluation"),
     ("objects", "test", "test is held out for evaluation"),
     ("objects", "housekeep/clamp_050_medium_clamp_M+train", "clamp_050_medium_clamp_M is held out for evaluation"),
+    ("objects", ("cube", "housekeep/clamp_050_medium_clamp_M"), "clamp_050_medium_clamp_M is held out for evaluation"),
+    ("objects", ("cube", ("test", 3)), "test is held out for evaluation"),
 ])
 def test_bad_training_settings_are_refused_before_anything_runs(tmp_path, field, value, words):
 

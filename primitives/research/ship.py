@@ -51,8 +51,8 @@ SHIPPED = "shipped"
 def role_files(skill: str) -> dict[str, str]:
     """The file name of each role in a weights folder: ``policy``, ``model`` (the goal-frame success model),
     ``frames``; and ``searched``, the searched success model (fitted, but named by no other file's info)."""
-    return {"policy": f"{skill}.pt", "model": f"{skill}_success.pt", "frames": f"{skill}_frames.json",
-            "searched": f"{skill}_success_searched.pt"}
+    ratings = {"model": "success", "frames": "frames", "searched": "searched"}  # role: weights_file.RATINGS name
+    return {"policy": f"{skill}.pt", **{role: weights_file.rating_name(skill, r) for role, r in ratings.items()}}
 
 
 def skill_files(folder: Path, skill: str) -> list[Path]:

@@ -128,12 +128,15 @@ def held_out(spec: str) -> bool:
     return Path(spec).suffix.lower() == ".obj" and Path(spec).stem in unseen
 
 
-def check_objects(objects: str, fitting: bool) -> None:
+def check_objects(objects: str | tuple[str, ...], fitting: bool) -> None:
     """Raise :class:`InputError` for an ``--objects`` naming no objects, or, when ``fitting`` (a policy, a model or
     a calibration is fitted on them), naming held-out objects (:func:`held_out`): test objects are never trained,
-    tuned or selected on."""
+    tuned or selected on. ``objects`` as :class:`EnvConfig` takes it: a ``+``-joined string, or a tuple of keys
+    (names, paths, procedural ``(split, index)`` pairs)."""
     object_groups(objects, 1)
-    held = [spec for spec in objects.split("+") if held_out(spec)]
+    specs = objects.split("+") if isinstance(objects, str) else [
+        key if isinstance(key, str) else str(key[0]) for key in objects]  # a pair names its split
+    held = [spec for spec in specs if held_out(spec)]
     if fitting and held:
         raise InputError(f"--objects {objects}: {', '.join(held)} is held out for evaluation; fit on train, "
                          "housekeep:training or housekeep:validation")

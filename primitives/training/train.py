@@ -221,8 +221,7 @@ def check_config(cfg: TrainConfig) -> None:
         raise InputError(f"--precision must be one of {PRECISIONS}, got {cfg.precision!r}")
     if cfg.p_scripted > 0.0 and cfg.primitive != "push":
         raise InputError(f"--p-scripted exists for push only (primitives.training.scripted), not {cfg.primitive}")
-    if isinstance(cfg.objects, str):
-        check_objects(cfg.objects, fitting=True)
+    check_objects(cfg.objects, fitting=True)
 
 
 # ---------------------------------------------------------------------------- learning
