@@ -73,6 +73,7 @@ TURN_BEFORE_MARGIN = 0.15
 SPIN_DETOUR_BELOW = 0.3
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
+SAME_POSE = 1e-9  # metres or radians within which two path ends are the same (_path)
 # Metres from the arm's base (the world origin) that an inflated footprint must stay within, so that the
 # fingertip can get behind the object from every side: its pre-contact point lies about 2.5 cm beyond the
 # inflated footprint (4 cm standoff and the 0.8 cm tip, less the 2 cm clearance, on a flat side; less on a
@@ -211,6 +212,7 @@ class Planner:
         self.graph = RestingStateGraph(obj, rate_edges=self._roll_probabilities)
         self.budget = DEFAULT_BUDGET  # primitives a plan's odds are rated within (planner.odds)
         self._calls = 0
+        self._paths: dict[tuple, np.ndarray] = {}  # this plan call's solved paths (_path)
 
     def fork(self) -> Planner:
         """A planner with this one's geometry, success queries and caches and a copy of its failure memory (the
@@ -348,6 +350,7 @@ class Planner:
         """
         t0 = time.perf_counter()
         deadline = t0 + self.time_limit
+        self._paths = {}
         asked = goal
         state, x, y, yaw = self.obj.planar_pose(T_start)
         goal_state, goal = self._checked_aim(goal, state)  # the free part of the goal's region
@@ -624,11 +627,25 @@ class Planner:
         return [min(turns, key=rank)]
 
     def _path(self, state: int, start, goal, deadline: float) -> np.ndarray:
+        """SE(2) path in resting state ``state`` from ``start`` to ``goal`` (x, y, yaw; :func:`plan_path`).
+
+        A plan call asks the same path once per roll placement that shares a segment (a route with two rolls in
+        place asks its last segment three times, its ends computed along different ways that agree to ~1e-16): the
+        path solved first in this call for ends within :data:`SAME_POSE` of these is returned again, its ends set
+        to these. OMPL is seeded alike throughout a call, so that path is the one solving again would give.
+        """
+        key = (state, *(round(float(v) / SAME_POSE) for v in (*start, *goal)))
+        if key in self._paths:
+            path = self._paths[key].copy()
+            path[0, :2], path[-1, :2] = start[:2], goal[:2]
+            return path
         left = deadline - time.perf_counter()
         if left <= 0:
             raise PlanningError(f"planning ran out of its {self.time_limit:.1f} s before reaching the goal")
-        return plan_path(self.checkers[state], tuple(start), tuple(goal), time_limit=min(left, 1.0),
+        path = plan_path(self.checkers[state], tuple(start), tuple(goal), time_limit=min(left, 1.0),
                          seed=self.seed + self._calls, attempts=2, turn_first=self._turn_first(state, start, goal))
+        self._paths[key] = path.copy()
+        return path
 
     def _turn_first(self, state: int, start, goal) -> bool:
         """Whether to turn before moving (push at the goal's yaw) rather than after (push at the start's yaw).

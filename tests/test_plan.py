@@ -352,3 +352,43 @@ def test_a_partly_blocked_goal_region_is_planned_to_its_free_part():
     assert ex.success and goal.reached(cube, ex.final_pose)
     with pytest.raises(GoalError, match="no free placement"):
         planner.plan(T0, ap.Goal(xy=(0.6, 0.1), yaw=0.0))
+
+
+def test_a_plan_call_solves_each_path_once_and_plans_as_if_it_solved_them_all(monkeypatch):
+    """A route of two rolls is planned for three roll placements, which ask some segments more than once: each
+    distinct path (ends within 1e-9) is solved once per call, and the plan is the one solving every ask gives."""
+    import planner.plan as plan_module
+
+    cube = ap.load_object("cube")
+    neighbours = set(skill_params.roll_targets(cube, 0))
+    opposite = next(s.index for s in cube.resting_states if s.index != 0 and s.index not in neighbours)
+    goal = ap.Goal(xy=(0.66, 0.05), yaw=1.0, resting_state=opposite)
+    T0 = cube.resting_states[0].pose((0.42, -0.1), 0.3)
+    solved = []
+    real = plan_module.plan_path
+
+    def counting(checker, start, end, **kwargs):
+        solved.append((id(checker), *np.round([*start, *end], 9)))
+        return real(checker, start, end, **kwargs)
+
+    monkeypatch.setattr(plan_module, "plan_path", counting)
+    planner = ideal_planner(cube, WALL_WITH_GAP)
+    asked = []
+    real_path = planner._path
+    monkeypatch.setattr(planner, "_path", lambda *a: asked.append(a) or real_path(*a))
+    plan = planner.plan(T0, goal)
+    assert len(plan.route) == 3
+    assert len(set(solved)) == len(solved) < len(asked)  # each path once; some were asked again
+
+    never_again = ideal_planner(cube, WALL_WITH_GAP)  # the same planner, its memory of paths wiped before each ask
+    real_again = never_again._path
+
+    def forgetful(*a):
+        never_again._paths.clear()
+        return real_again(*a)
+
+    monkeypatch.setattr(never_again, "_path", forgetful)
+    again = never_again.plan(T0, goal)
+    assert [(s.skill, s.params) for s in again.steps] == [(s.skill, s.params) for s in plan.steps]
+    for (_, p1), (_, p2) in zip(plan.paths, again.paths, strict=True):
+        np.testing.assert_array_equal(p1, p2)
