@@ -131,3 +131,66 @@ def test_portable_drops_the_checkout_s_path_from_every_string(tmp_path):
             "nested": [f"{tmp_path}", 3, {"frames": "shipped"}]}
     assert portable(info, tmp_path) == {"model": "runs/a/success.pt", "command": "python -m x --out runs/b --flag",
                                         "nested": [".", 3, {"frames": "shipped"}]}
+
+
+@pytest.fixture
+def camera_layout(tmp_path):
+    """A weights folder with the shipped push (a policy trained on the surface sample) and its camera ratings, and
+    a set holding one camera rating refitted with a run's copy of the shipped policy."""
+    weights, cand, base = tmp_path / "weights", tmp_path / "cand", tmp_path / "base"
+    (weights / "cameras").mkdir(parents=True)
+    cand.mkdir()
+    for name in CORE:
+        shutil.copy2(WEIGHTS_DIR / name, weights / name)
+    for name in ("push_success.pt", "push_frames.json", "push_success_searched.pt"):
+        shutil.copy2(WEIGHTS_DIR / "cameras" / name, weights / "cameras" / name)
+    shutil.copy2(WEIGHTS_DIR / "cameras" / "push_frames.json", cand / "push_frames.json")
+    (base / "runs" / "p").mkdir(parents=True)
+    shutil.copy2(weights / "push.pt", base / "runs" / "p" / "policy.pt")
+    set_info(cand / "push_frames.json", policy="runs/p/policy.pt", model="shipped", platt_note="refit")
+    return weights, cand, base
+
+
+def test_camera_ratings_ship_into_the_sensor_folder_and_only_what_they_replace_is_kept(camera_layout):
+    weights, cand, base = camera_layout
+    before = {p.name: digest(p) for p in (weights / "cameras").iterdir()}
+    beside = {p.name: digest(p) for p in weights.iterdir() if p.is_file()}
+    plan = plan_ship("push", cand, "push_cam_old", weights_dir=weights, base=base, sensor="cameras")
+    assert plan.target == weights / "cameras" and [p.name for p in plan.to_keep] == ["push_frames.json"]
+    policy = digest(weights / "push.pt")[:12]
+    assert plan.checked == [f"push_frames.json: policy runs/p/policy.pt = push.pt (sha256 {policy})"]
+    ship(plan, "9.9.9")
+
+    assert {p.name: digest(p) for p in (base / "candidates" / "push_cam_old").iterdir()} == {
+        "push_frames.json": before["push_frames.json"]}
+    after = {p.name: digest(p) for p in (weights / "cameras").iterdir()}
+    assert after.keys() == before.keys() and after["push_success.pt"] == before["push_success.pt"]
+    assert {p.name: digest(p) for p in weights.iterdir() if p.is_file()} == beside  # the policy's own files untouched
+    frames = json.loads((weights / "cameras" / "push_frames.json").read_text())["info"]
+    assert frames["policy"] == "shipped" and frames["trained_with"]["policy"] == "runs/p/policy.pt"
+    assert frames["platt_note"] == "refit"
+    skill = load_skill("push", weights_dir=weights)
+    assert skill.rated_sensors == ("surface", "cameras")
+    assert skill.ratings("cameras").frame_search.info["platt_note"] == "refit"
+
+
+@pytest.mark.parametrize("case", ["holds a policy", "the policy's own sensor", "no rating", "another policy",
+                                  "unknown sensor"])
+def test_camera_ratings_that_cannot_ship_are_refused_before_anything_moves(camera_layout, case):
+    weights, cand, base = camera_layout
+    sensor = "cameras"
+    if case == "holds a policy":
+        shutil.copy2(weights / "push.pt", cand / "push.pt")
+    elif case == "the policy's own sensor":
+        sensor = "surface"
+    elif case == "no rating":
+        (cand / "push_frames.json").unlink()
+    elif case == "another policy":
+        shutil.copy2(CANDIDATES / "push_0.16" / "push.pt", base / "runs" / "p" / "policy.pt")
+    else:
+        sensor = "lidar"
+    before = {p.relative_to(weights): digest(p) for p in weights.rglob("*") if p.is_file()}
+    with pytest.raises(InputError):
+        plan_ship("push", cand, "push_cam_old", weights_dir=weights, base=base, sensor=sensor)
+    assert {p.relative_to(weights): digest(p) for p in weights.rglob("*") if p.is_file()} == before
+    assert not (base / "candidates").exists()

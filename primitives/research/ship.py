@@ -24,6 +24,14 @@ Shipping does, in this order, and changes nothing until every check has passed:
 
 This is what releases 0.17 (roll), 0.18 (push) and 0.19 (spin) did by hand. The record of commands and figures
 (``weights/RECORD.md``) is still written by hand; the command prints what to put in it.
+
+**Ratings for another sensor** (``--sensor cameras``): the set holds some of the shipped policy's three ratings
+refitted to that sensor's clouds, and no policy; they ship into ``weights/{sensor}/``
+(:func:`primitives.weights_file.rating_path`), which is refused for the sensor the policy was trained on (its own
+ratings serve it). Their ``policy`` must be the shipped one, and a ``model`` or ``frames`` they name the set's own
+or the one that serves the sensor now. Only the files the set replaces are kept; the subfolder's others stay.
+
+    python -m primitives.research.ship roll --sensor cameras --from candidates/roll_cam --keep roll_cam_0.24
 """
 
 from __future__ import annotations
@@ -33,15 +41,20 @@ import hashlib
 import os
 import shutil
 import sys
+import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from affordplan.errors import AffordplanError, InputError, WeightsError
 from affordplan.log import cli_logging
+from affordplan.sim.sensor import SENSORS
 from primitives import weights_file
 from primitives.frames import FrameSearch
 from primitives.training.env import PRIMITIVES
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
+from primitives.weights_file import policy_sensor, rating_path
+
+RATING_OF = {"model": "success", "frames": "frames", "searched": "searched"}  # role: weights_file.RATINGS name
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 ROLES = ("policy", "model", "frames")  # the info keys of a fitted file that name the files it was fitted with
@@ -51,8 +64,7 @@ SHIPPED = "shipped"
 def role_files(skill: str) -> dict[str, str]:
     """The file name of each role in a weights folder: ``policy``, ``model`` (the goal-frame success model),
     ``frames``; and ``searched``, the searched success model (fitted, but named by no other file's info)."""
-    ratings = {"model": "success", "frames": "frames", "searched": "searched"}  # role: weights_file.RATINGS name
-    return {"policy": f"{skill}.pt", **{role: weights_file.rating_name(skill, r) for role, r in ratings.items()}}
+    return {"policy": f"{skill}.pt", **{role: weights_file.rating_name(skill, r) for role, r in RATING_OF.items()}}
 
 
 def skill_files(folder: Path, skill: str) -> list[Path]:
@@ -91,9 +103,15 @@ class ShipPlan:
     digests: dict[str, str]  # sha256 of the set's file of each role it holds (policy, model, frames)
     checked: list[str] = field(default_factory=list)  # "model: policy runs/x/policy.pt = push.pt (sha256 ab12...)"
     unchecked: list[str] = field(default_factory=list)  # run paths absent from this machine
+    sensor: str | None = None  # ratings for this sensor's clouds, shipped into weights_dir/sensor/
+
+    @property
+    def target(self) -> Path:
+        """The folder the set's files are copied into."""
+        return self.weights_dir if self.sensor is None else self.weights_dir / self.sensor
 
     def describe(self) -> str:
-        lines = [f"ship {self.skill} from {self.source} into {self.weights_dir}",
+        lines = [f"ship {self.skill} from {self.source} into {self.target}",
                  f"keep {len(self.to_keep)} shipped file(s) in {self.keep_dir}:"]
         lines += [f"  {p.name}" for p in self.to_keep]
         lines += [f"copy {len(self.to_copy)} file(s):"] + [f"  {p.name}" for p in self.to_copy]
@@ -103,15 +121,18 @@ class ShipPlan:
 
 
 def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path | None = None,
-              base: str | Path = ".") -> ShipPlan:
+              base: str | Path = ".", sensor: str | None = None) -> ShipPlan:
     """Check a candidate set (module docstring, step 1) and say what shipping it would move; change nothing.
 
     ``base``: the folder that relative run paths in the files' ``info`` are taken from (the repository root,
     where the training commands ran); the files now shipped are kept in ``base/candidates/KEEP``.
+    ``sensor``: the set holds ratings of the shipped policy refitted to this sensor's clouds (module docstring).
     Raises :class:`InputError` for a set that cannot ship.
     """
     from primitives.skills import load_skill
 
+    if sensor is not None and sensor not in SENSORS:
+        raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
     if skill not in PRIMITIVES:
         raise InputError(f"unknown skill {skill!r}; expected one of {PRIMITIVES}")
     source = Path(source)
@@ -126,16 +147,22 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
     if keep_dir.exists():
         raise InputError(f"{keep_dir} exists already; choose another --keep name")
     names = role_files(skill)
-    for role in ("policy", "model"):
-        if not (source / names[role]).exists():
-            raise InputError(f"the candidate set has no {names[role]} (its {role})")
-    try:
-        load_skill(skill, weights_dir=source)
-    except AffordplanError as exc:
-        raise InputError(f"the candidate set does not load as the {skill} skill: {exc}") from exc
-    digests = {role: sha256(source / names[role]) for role in ROLES if (source / names[role]).exists()}
-    plan = ShipPlan(skill, source, weights_dir, keep_dir, skill_files(weights_dir, skill), skill_files(source, skill),
-                    digests)
+    if sensor is None:
+        for role in ("policy", "model"):
+            if not (source / names[role]).exists():
+                raise InputError(f"the candidate set has no {names[role]} (its {role})")
+        try:
+            load_skill(skill, weights_dir=source)
+        except AffordplanError as exc:
+            raise InputError(f"the candidate set does not load as the {skill} skill: {exc}") from exc
+        serving = {role: source / names[role] for role in ROLES if (source / names[role]).exists()}
+        to_keep = skill_files(weights_dir, skill)
+    else:
+        serving = _ratings_serving(skill, source, weights_dir, sensor)
+        to_keep = [p for p in skill_files(weights_dir / sensor, skill) if (source / p.name).exists()] \
+            if (weights_dir / sensor).is_dir() else []
+    digests = {role: sha256(path) for role, path in serving.items()}
+    plan = ShipPlan(skill, source, weights_dir, keep_dir, to_keep, skill_files(source, skill), digests, sensor=sensor)
     for fitted in ("model", "frames", "searched"):
         path = source / names[fitted]
         if not path.exists():
@@ -145,7 +172,7 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
             named = info.get(role)
             if named is None or role == fitted or named == SHIPPED:
                 continue
-            own = source / names[role]
+            own = serving.get(role, source / names[role])
             if role not in digests:
                 raise InputError(f"{path.name} was fitted with a {role} ({named}) the set does not hold ({own.name})")
             run_file = Path(named) if Path(named).is_absolute() else Path(base) / named
@@ -153,11 +180,56 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
                 plan.unchecked.append(f"{path.name}: {role} {named}")
                 continue
             digest = sha256(run_file)
+            whose = "the set's" if own.parent == source else "the shipped"
             if digest != digests[role]:
-                raise InputError(f"{path.name} was fitted with {named}, which is not the set's {own.name} "
+                raise InputError(f"{path.name} was fitted with {named}, which is not {whose} {own.name} "
                                  f"(sha256 {digest[:12]} against {digests[role][:12]})")
             plan.checked.append(f"{path.name}: {role} {named} = {own.name} (sha256 {digest[:12]})")
     return plan
+
+
+def _ratings_serving(skill: str, source: Path, weights_dir: Path, sensor: str) -> dict[str, Path]:
+    """For a set of ``sensor`` ratings (module docstring): check it, and return the file that will serve each role
+    once it ships (the set's own, else the shipped policy and the ratings serving ``sensor`` now)."""
+    from primitives.skills import load_skill
+
+    names = role_files(skill)
+    policy = weights_dir / names["policy"]
+    if (source / names["policy"]).exists():
+        raise InputError(f"a set of {sensor} ratings holds no policy; {source / names['policy']} is one "
+                         f"(ship a policy with its own ratings without --sensor)")
+    if not policy.is_file():
+        raise InputError(f"{weights_dir} has no {names['policy']} for the {sensor} ratings to rate")
+    own = policy_sensor(skill, weights_dir)
+    if own == sensor:
+        raise InputError(f"the shipped {names['policy']} was trained on {sensor} clouds: the ratings beside it serve "
+                         f"them, and {weights_dir / sensor} would never be read; ship them without --sensor")
+    held = [role for role in RATING_OF if (source / names[role]).exists()]
+    if not held:
+        raise InputError(f"the candidate set holds none of {[names[r] for r in RATING_OF]}")
+    with tempfile.TemporaryDirectory() as tmp:  # the weights folder as it would be, for the load check
+        overlay = Path(tmp)
+        shutil.copy2(policy, overlay / policy.name)
+        for role in RATING_OF:
+            now = rating_path(skill, RATING_OF[role], sensor, weights_dir, trained_on=own)
+            if now.exists():
+                shutil.copy2(now, overlay / names[role])
+        (overlay / sensor).mkdir()
+        for role in held:
+            shutil.copy2(source / names[role], overlay / sensor / names[role])
+        try:
+            skill_ = load_skill(skill, weights_dir=overlay)
+        except AffordplanError as exc:
+            raise InputError(f"the {sensor} ratings do not load with the shipped {skill} policy: {exc}") from exc
+        if sensor not in skill_.rated_sensors:
+            raise InputError(f"the {sensor} ratings are not read for the shipped {skill} policy")
+    serving = {"policy": policy}
+    for role in ("model", "frames"):
+        path = source / names[role] if role in held else rating_path(skill, RATING_OF[role], sensor, weights_dir,
+                                                                      trained_on=own)
+        if path.exists():
+            serving[role] = path
+    return serving
 
 
 def portable(value, root: Path = REPO_ROOT):
@@ -202,10 +274,11 @@ def ship(plan: ShipPlan, release: str) -> None:
     plan.keep_dir.mkdir(parents=True)
     for path in plan.to_keep:
         shutil.move(str(path), plan.keep_dir / path.name)
+    plan.target.mkdir(exist_ok=True)
     for path in plan.to_copy:
-        shutil.copy2(path, plan.weights_dir / path.name)
+        shutil.copy2(path, plan.target / path.name)
     for fitted in ("model", "frames", "searched"):
-        path = plan.weights_dir / names[fitted]
+        path = plan.target / names[fitted]
         if path.exists() and (plan.source / names[fitted]).exists():
             relabel(path, release, plan.digests)
 
@@ -219,11 +292,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="folder name under candidates/ (in the repository root) for the files now shipped")
     parser.add_argument("--release", default=None, help="the release the note names (default: the package version)")
     parser.add_argument("--weights-dir", default=None, help="the weights folder to ship into (default: the package's)")
+    parser.add_argument("--sensor", choices=SENSORS, default=None,
+                        help="the set holds ratings of the shipped policy refitted to this sensor's clouds: ship them "
+                             "into weights/SENSOR/ (default: the set is a policy with its own ratings)")
     parser.add_argument("--dry-run", action="store_true", help="check and print what would move; change nothing")
     args = parser.parse_args(argv)
     cli_logging()
     try:
-        plan = plan_ship(args.skill, args.source, args.keep, args.weights_dir)
+        plan = plan_ship(args.skill, args.source, args.keep, args.weights_dir, sensor=args.sensor)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
