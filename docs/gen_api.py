@@ -146,9 +146,9 @@ def document_module(name: str) -> list[str]:
     """Markdown lines for one module."""
     try:
         module = importlib.import_module(name)
-    except Exception as exc:  # a module mid-edit must not stop the rest of the reference
-        print(f"warning: cannot import {name}: {type(exc).__name__}: {exc}", file=sys.stderr)
-        return [f"### `{name}`", "", f"(not documented: the module failed to import: {type(exc).__name__})", ""]
+    except Exception as exc:  # a reference with holes is not written (0.24.0.dev0 shipped one with 83)
+        raise SystemExit(f"error: cannot import {name} ({type(exc).__name__}: {exc}); run this with the "
+                         f"project installed (the README's set-up), from the repository root") from exc
     lines = [f"### `{name}`", ""] + _indent_doc(_doc(module))
     for attr in _public_names(module):
         value = getattr(module, attr, None)

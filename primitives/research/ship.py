@@ -232,9 +232,11 @@ def _ratings_serving(skill: str, source: Path, weights_dir: Path, sensor: str) -
     return serving
 
 
-def portable(value, root: Path = REPO_ROOT):
-    """``value`` with every mention of the repository's absolute path ``root`` dropped from its strings (in dicts and
-    lists too), so that a shipped file names its runs as ``runs/...``, not by where this checkout lies."""
+def portable(value, root: Path | None = None):
+    """``value`` with every mention of the repository's absolute path ``root`` (default: this checkout's) dropped from
+    its strings (in dicts and lists too), so that a shipped file names its runs as ``runs/...``, not by where this
+    checkout lies."""
+    root = REPO_ROOT if root is None else root
     if isinstance(value, str):
         return value.replace(f"{root}{os.sep}", "").replace(str(root), ".")
     if isinstance(value, dict):
