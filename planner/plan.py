@@ -51,6 +51,7 @@ from planner.memory import FAILURES_TO_AVOID, FailureMemory
 from planner.motion import FootprintChecker, plan_path
 from planner.odds import DEFAULT_BUDGET, Odds, mc_odds, plan_odds
 from planner.predict import Predictor, expected_pose, state_pose
+from planner.ratings import StateRatings
 from primitives.params import PARAMS_TYPES, SkillName, SkillParams, as_params
 
 if TYPE_CHECKING:  # planner.execute imports this module's Planner; Plan.execute imports it when called
@@ -64,8 +65,7 @@ DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  #
 # A goal yaw is reached before the last roll, where spinning is likelier to succeed, when the success
 # model rates a 30 deg spin there this much higher than in the goal's resting state (a frustum on its
 # side, say, cannot be spun; on its base it can).
-TURN_PROBE_ANGLE = math.radians(30.0)
-SPIN_RATE_GRID = np.radians([15.0, 25.0, 35.0, 45.0])  # spin angles rated per state to split turns (_spin_rate)
+# (the 30 deg spin is planner.ratings.TURN_PROBE_ANGLE)
 TURN_BEFORE_MARGIN = 0.15
 # Where the goal's resting state spins this badly (predicted, or spins there failed twice) and no roll into
 # it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
@@ -200,8 +200,6 @@ class Planner:
         self.clearance = clearance
         self.roll_margin = roll_margin
         self.memory = FailureMemory(obj)  # failed calls and roll spots (planner.memory)
-        self._spin_p: dict[int, float] = {}  # resting state -> predicted spin success (_spin_probability)
-        self._spin_rates: dict[tuple[int, int], np.ndarray] = {}  # (state, sense) -> P(spin) over SPIN_RATE_GRID
         self.reach = reach
         self.footprints = inflated_footprints(obj, clearance)
         self._shadows = {s.index: footprint(obj, s.index) for s in obj.resting_states}  # not inflated
@@ -209,7 +207,8 @@ class Planner:
         self._standoff = Protocol().standoff
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace, reach)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
-        self.graph = RestingStateGraph(obj, rate_edges=self._roll_probabilities)
+        self.ratings = StateRatings(obj, self.predictor, workspace.center)  # rolls and spins per state
+        self.graph = RestingStateGraph(obj, rate_edges=self.ratings.rolls)
         self.budget = DEFAULT_BUDGET  # primitives a plan's odds are rated within (planner.odds)
         self._calls = 0
         self._paths: dict[tuple, np.ndarray] = {}  # this plan call's solved paths (_path)
@@ -234,12 +233,6 @@ class Planner:
         return plan_odds([s.p_success for s in steps], budget)
 
     # ------------------------------------------------------------------ queries
-    def _roll_probabilities(self, edges: list[tuple[int, int]]) -> np.ndarray:
-        """P(roll i -> j) for each edge, at the workspace centre with yaw 0 (one batched query)."""
-        x, y = self.workspace.center
-        return self.predictor.p_success_many([("roll", {"target": j}, state_pose(self.obj, i, x, y, 0.0))
-                                              for i, j in edges])
-
     def record_failure(self, skill: str, params: dict, T_world_object: np.ndarray) -> int:
         """Remember a failed call; returns how often that (state, skill, parameter) has failed."""
         count = self.memory.record(skill, params, T_world_object)
@@ -443,7 +436,7 @@ class Planner:
         """
         def calls_for(path: np.ndarray, yaw: float | None) -> list[chain.Call]:
             return chain.path_to_calls(path, yaw, is_free=self.checkers[state].is_free,
-                                       spin_rate=self._spin_rate(state))
+                                       spin_rate=self.ratings.spin_rate(state))
 
         out: list[chain.Call] = []
         if not self.checkers[state].is_free(*start):
@@ -506,8 +499,8 @@ class Planner:
             new_state = params["target"] if skill == "roll" else call_state
             T_next = state_pose(self.obj, new_state, *after)
             steps.append(Step(skill, params, T, T_next))
-            if skill == "spin":  # rated by the state's spin row, as its split was (_spin_rate)
-                steps[-1].p_success = self._spin_rate(call_state)(params["angle"])
+            if skill == "spin":  # rated by the state's spin row, as its split was (StateRatings.spin_rate)
+                steps[-1].p_success = self.ratings.spin_rate(call_state)(params["angle"])
             T = T_next
         asked = [s for s in steps if s.skill != "spin"]
         if asked:
@@ -516,42 +509,11 @@ class Planner:
                 s.p_success = float(p)
         return steps
 
-    def _spin_probability(self, state: int) -> float:
-        """Predicted success of a 30 deg spin (mean of both ways) in ``state`` at the workspace centre.
-
-        Like the graph's roll probabilities, it does not depend on where the object is: asked once per state.
-        """
-        if state not in self._spin_p:
-            x, y = self.workspace.center
-            T = state_pose(self.obj, state, x, y, 0.0)
-            turns = [{"angle": a} for a in (TURN_PROBE_ANGLE, -TURN_PROBE_ANGLE)]
-            self._spin_p[state] = float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
-        return self._spin_p[state]
-
-    def _spin_rate(self, state: int) -> Callable[[float], float]:
-        """``rate(angle)``: predicted success of a spin by ``angle`` (radians, signed, 15-45 deg) in ``state``.
-
-        Read off :data:`SPIN_RATE_GRID` by linear interpolation. Each sense's row is asked once per state, when
-        first needed, at the workspace centre and yaw 0, as :meth:`_spin_probability` is: with the shipped spin's
-        frame search the rating hardly depends on the yaw (it is the best over turns of the frame), and a row
-        costs ``len(SPIN_RATE_GRID)`` frame-searched queries.
-        """
-        def rate(angle: float) -> float:
-            key = (state, 1 if angle > 0 else -1)
-            if key not in self._spin_rates:
-                x, y = self.workspace.center
-                T = state_pose(self.obj, state, x, y, 0.0)
-                self._spin_rates[key] = self.predictor.p_success_many(
-                    [("spin", {"angle": float(key[1] * a)}, T) for a in SPIN_RATE_GRID])
-            return float(np.interp(abs(angle), SPIN_RATE_GRID, self._spin_rates[key]))
-
-        return rate
-
     def _spin_rating(self, state: int) -> float:
-        """:meth:`_spin_probability`, or 0 where a spin in ``state`` (either way) has failed twice."""
+        """:meth:`StateRatings.spin`, or 0 where a spin in ``state`` (either way) has failed twice."""
         if self.memory.spin_failed(state):
             return 0.0
-        return self._spin_probability(state)
+        return self.ratings.spin(state)
 
     def _turns_better(self, before: int, goal_state: int) -> bool:
         """Whether the object spins clearly better in state ``before`` than in the goal's resting state."""
