@@ -42,7 +42,8 @@ MODULES: list[tuple[str, list[str]]] = [
                                       "primitives.research.sensitivity", "primitives.research.ship",
                                       "primitives.research.curves"]),
     ("Planning internals", ["planner.graph", "planner.footprint", "planner.motion", "planner.chain",
-                            "planner.predict", "planner.ratings", "planner.memory", "planner.odds"]),
+                            "planner.predict", "planner.places", "planner.ratings", "planner.memory",
+                            "planner.odds"]),
     ("Benchmarks", ["affordplan.app.bench.primitive", "affordplan.app.bench.plan"]),
 ]
 

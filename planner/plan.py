@@ -32,8 +32,8 @@ import copy
 import math
 import time
 from collections import Counter
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -50,6 +50,7 @@ from planner.graph import RestingStateGraph
 from planner.memory import FAILURES_TO_AVOID, FailureMemory
 from planner.motion import FootprintChecker, plan_path
 from planner.odds import DEFAULT_BUDGET, Odds, mc_odds, plan_odds
+from planner.places import Places, disc
 from planner.predict import Predictor, expected_pose, state_pose
 from planner.ratings import StateRatings
 from primitives.params import PARAMS_TYPES, SkillName, SkillParams, as_params
@@ -80,20 +81,6 @@ SAME_POSE = 1e-9  # metres or radians within which two path ends are the same (_
 # corner) and must be within FINGERTIP_REACH. Without it, a die spun or pushed 7 cm past its goal at
 # x = 0.68 m could no longer be pushed back: every contact on its far side was out of reach.
 ARM_REACH = FINGERTIP_REACH - 0.025  # 0.79 m
-# How far a spin is taken to shift an object, in multiples of its radius (Planner.spin_room). Measured (arm sim,
-# shipped spin, 25-35 deg): 16 spins of the 10 cm cube shifted it 2.4-7.1 cm, median 6.4 cm, for a radius of
-# 7.1 cm; 10 of the mug 2.4-4.3 cm, median 3.2 cm, for a radius of 6.1 cm. A whole radius (the worst seen) cost
-# a large frustum its goal 0.65 m out on bench seed 0 (0.90 against 0.92); half of it and none scored alike
-# on seeds 0 and 1 (0.92, 0.84), and half still keeps the die's turns off its goal 0.68 m out.
-SPIN_DRIFT = 0.5
-FREE_YAW_STEPS = np.radians([0.0] + [sign * a for a in range(5, 180, 5) for sign in (1, -1)] + [180.0])
-# A goal is a region: where its exact point is not free, the plan aims at the nearest free placement (rings of
-# GOAL_AIM_RING metres, turns of GOAL_AIM_YAW_STEP radians) within GOAL_AIM_SHARE of its tolerances.
-GOAL_AIM_SHARE = 0.6
-GOAL_AIM_RING = 0.002
-GOAL_AIM_YAW_STEP = math.radians(2.5)
-FREE_SEARCH_SLACK = 0.02  # metres past the nearest free position that _nearest_free looks for a better one
-TURN_SPOT_MOVE_COST = 0.05  # metres of path a turn spot other than the object's own place must save (_turn_spot)
 # Radius (metres) of the disc kept clear of obstacles where the fingertip comes down behind an object to push
 # it (Planner.push_blocked): the tip's, plus a margin.
 FINGER_ROOM = TIP_RADIUS + 0.006
@@ -137,26 +124,6 @@ class Step:
         return f"{self.skill:4s} {k}={value:10s} -> ({x:.3f}, {y:.3f})  P={self.p_success:.2f}"
 
 
-def _disc(radius: float, n: int) -> np.ndarray:
-    """A regular ``n``-gon of circumradius ``radius`` metres about the origin, (n, 2)."""
-    a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
-    return radius * np.stack([np.cos(a), np.sin(a)], axis=1)
-
-
-def _grid_argmin(workspace: Workspace, cost: Callable[[float, float], float], ok: Callable[[float, float], bool],
-                 step: float = 0.01) -> tuple[float, float] | None:
-    """The point of a ``step`` (metres) grid over ``workspace`` with the lowest ``cost`` among those where ``ok``
-    holds (the first on a tie, x then y ascending; ``ok``, the costly test, only where the cost would win);
-    ``None`` where it holds nowhere."""
-    best, best_cost = None, math.inf
-    for px in np.arange(workspace.x[0], workspace.x[1] + 1e-9, step):
-        for py in np.arange(workspace.y[0], workspace.y[1] + 1e-9, step):
-            c = cost(float(px), float(py))
-            if c < best_cost and ok(float(px), float(py)):
-                best, best_cost = (float(px), float(py)), c
-    return best
-
-
 def inflated_footprints(obj: ObjectModel, clearance: float) -> dict[int, np.ndarray]:
     """Each resting state's footprint grown by ``clearance`` metres (room for the fingertip)."""
     return {s.index: inflate(footprint(obj, s.index), clearance) for s in obj.resting_states}
@@ -185,7 +152,7 @@ class Planner:
         clearance: metres the footprint is grown by (room for the fingertip beside the object).
         roll_margin: metres around a roll spot kept clear for the displacement a roll causes.
         reach: metres from the arm's base (the world origin) that the inflated footprints stay within, and
-            within which spins are placed with room to drift (:meth:`spin_room`); ``None``: no arm to reach.
+            within which spins are placed with room to drift (:meth:`Places.spin_room`); ``None``: no arm to reach.
     """
 
     def __init__(self, obj: ObjectModel, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
@@ -203,10 +170,11 @@ class Planner:
         self.reach = reach
         self.footprints = inflated_footprints(obj, clearance)
         self._shadows = {s.index: footprint(obj, s.index) for s in obj.resting_states}  # not inflated
-        self._finger = FootprintChecker(_disc(FINGER_ROOM, 8), self.obstacles, Workspace((-2.0, 2.0), (-2.0, 2.0)))
+        self._finger = FootprintChecker(disc(FINGER_ROOM, 8), self.obstacles, Workspace((-2.0, 2.0), (-2.0, 2.0)))
         self._standoff = Protocol().standoff
         self.checkers = make_checkers(self.footprints, self.obstacles, workspace, reach)
         self.radius = {i: float(np.max(np.linalg.norm(fp, axis=1))) for i, fp in self.footprints.items()}
+        self.places = Places(obj, self.checkers, workspace, self.obstacles, self.radius, clearance, roll_margin, reach)
         self.ratings = StateRatings(obj, self.predictor, workspace.center)  # rolls and spins per state
         self.graph = RestingStateGraph(obj, rate_edges=self.ratings.rolls)
         self.budget = DEFAULT_BUDGET  # primitives a plan's odds are rated within (planner.odds)
@@ -288,49 +256,7 @@ class Planner:
         state = start_state if goal.resting_state is None else goal.resting_state
         if not self.workspace.contains(goal.xy):
             raise GoalError(f"goal xy={goal.xy} is outside the workspace {self.workspace}")
-        return state, self.aim(goal, state)
-
-    def aim(self, goal: Goal, state: int) -> Goal:
-        """The point of the goal's region the plan aims at: the goal itself where the object fits there, else the
-        free placement nearest it within the region (a goal is its tolerance disc and yaw interval, not a point).
-
-        Aims stay inside ``GOAL_AIM_SHARE`` of the tolerances, so the drift of the last primitive still leaves the
-        object in the region. Raises :class:`GoalError` when no part of the region is free.
-        """
-        checker = self.checkers[state]
-        free_yaw = goal.yaw_free(self.obj, state)
-        if free_yaw:  # the yaws _free_yaw will try to place the object at the goal
-            yaws = [(0.0, float(a)) for a in FREE_YAW_STEPS]
-        else:  # the goal's yaw, the yaws its state's symmetry makes equal to it, then turns within the interval
-            period = goal.period(self.obj, state)
-            turns = [0.0] + [s * a for a in np.arange(GOAL_AIM_YAW_STEP, GOAL_AIM_SHARE * goal.yaw_tol + 1e-9,
-                                                        GOAL_AIM_YAW_STEP) for s in (1.0, -1.0)]
-            yaws = [(abs(d), goal.yaw + d + k * period) for d in turns
-                    for k in range(int(round(2.0 * math.pi / period)))]
-        reach = GOAL_AIM_SHARE * goal.xy_tol
-        spots = [(0.0, *goal.xy)]
-        for r in np.arange(GOAL_AIM_RING, reach + 1e-9, GOAL_AIM_RING):
-            n = max(8, int(2 * math.pi * r / GOAL_AIM_RING))
-            spots += [(float(r), goal.xy[0] + r * math.cos(a), goal.xy[1] + r * math.sin(a))
-                      for a in np.linspace(-math.pi, math.pi, n, endpoint=False)]
-        best = None
-        for r, x, y in spots:
-            if best is not None and r > best[0]:
-                break
-            for turn, a in sorted(yaws):
-                if self.workspace.contains((x, y)) and checker.is_free(x, y, a):
-                    if best is None or (r, turn) < best[:2]:
-                        best = (r, turn, x, y, a)
-                    break
-        if best is None:
-            why = checker.why_not_free(*goal.xy, yaws[0][1])
-            raise GoalError(f"goal xy={goal.xy} is not reachable by the object in resting state {state}: no free "
-                            f"placement within {100 * reach:.1f} cm of it ({why})")
-        r, turn, x, y, a = best
-        if r == 0.0 and turn == 0.0:
-            return goal
-        return replace(goal, xy=(float(x), float(y)), yaw=None if free_yaw else float(wrap_angle(a)),
-                       xy_tol=goal.xy_tol - r, yaw_tol=goal.yaw_tol - turn)
+        return state, self.places.aim(goal, state)
 
     # --------------------------------------------------------------------- plan
     def plan(self, T_start: np.ndarray, goal: Goal) -> Plan:
@@ -382,12 +308,12 @@ class Planner:
         paths: list[tuple[int, np.ndarray]] = []
         cur = start
         for k, (a, b) in enumerate(zip(route, route[1:])):
-            spot = self._roll_spot(a, b, cur, goal, late=k >= late_from)
+            spot = self.places.roll_spot(a, b, cur, goal, late=k >= late_from, spoiled=self.memory.spoiled)
             want_yaw = cur[2]
             last_roll = k == len(route) - 2
             if turn and last_roll and self._turns_better(a, goal_state):
                 want_yaw = self._yaw_before_roll(a, b, spot, goal, cur[2])  # turn here, arrive turned
-            spot_yaw = self._free_yaw(a, spot, want_yaw)
+            spot_yaw = self.places.free_yaw(a, spot, want_yaw)
             segment_paths, segment = self._segment(a, cur, (*spot, spot_yaw), deadline)
             paths += [(a, path) for path in segment_paths]
             calls += [(a, *c) for c in segment]
@@ -402,7 +328,8 @@ class Planner:
         # stride to the goal's centre (two short pushes in a V, each likelier to overshoot than to help)
         late = late_from < len(route) - 1
         end = cur[:2] if late and math.dist(cur[:2], goal.xy) <= 0.5 * goal.xy_tol else goal.xy
-        goal_yaw = goal.yaw_near(self.obj, goal_state, cur[2]) if turn else self._free_yaw(goal_state, end, cur[2])
+        goal_yaw = (goal.yaw_near(self.obj, goal_state, cur[2]) if turn
+                    else self.places.free_yaw(goal_state, end, cur[2]))
         segment_paths, segment = self._segment(goal_state, cur, (*end, goal_yaw), deadline,
                                                goal_yaw if turn else None)
         paths += [(goal_state, path) for path in segment_paths]
@@ -430,9 +357,9 @@ class Planner:
         ``final_yaw`` at the end when given.
 
         Where the start is not free (the object was pushed into a tight spot, or a roll is expected to leave it
-        there), it is first pushed to the nearest free place (:meth:`_nearest_free`). Where the calls would
-        spin the object without room to drift (:meth:`spin_room`), the turn is made at a spot that has it
-        (:meth:`_turn_spot`): push there at the start's yaw, turn, push on at the end's.
+        there), it is first pushed to the nearest free place (:meth:`Places.nearest_free`). Where the calls would
+        spin the object without room to drift (:meth:`Places.spin_room`), the turn is made at a spot that has it
+        (:meth:`Places.turn_spot`): push there at the start's yaw, turn, push on at the end's.
         """
         def calls_for(path: np.ndarray, yaw: float | None) -> list[chain.Call]:
             return chain.path_to_calls(path, yaw, is_free=self.checkers[state].is_free,
@@ -440,14 +367,14 @@ class Planner:
 
         out: list[chain.Call] = []
         if not self.checkers[state].is_free(*start):
-            free = self._nearest_free(state, start, end)
+            free = self.places.nearest_free(state, start, end, avoided=self._avoided)
             out.append(("push", {"direction": math.atan2(free[1] - start[1], free[0] - start[0])}, (*free, start[2])))
             start = (*free, start[2])
         path = self._path(state, start, end, deadline)
         calls = calls_for(path, final_yaw)
-        if all(self.spin_room(state, *after[:2]) for skill, _, after in calls if skill == "spin"):
+        if all(self.places.spin_room(state, *after[:2]) for skill, _, after in calls if skill == "spin"):
             return [path], out + calls
-        spot = self._turn_spot(state, start, end)
+        spot = self.places.turn_spot(state, start, end)
         if spot is None:
             return [path], out + calls
         try:
@@ -456,34 +383,6 @@ class Planner:
         except (PlanningError, GoalError):  # no way round by the spot in time: turn where the path does
             return [path], out + calls
         return [to_spot, from_spot], out + calls_for(to_spot, end[2]) + calls_for(from_spot, final_yaw)
-
-    def spin_room(self, state: int, x: float, y: float) -> bool:
-        """Whether the object (in ``state``, centred at ``(x, y)``) may be spun there: its inflated footprint
-        stays within ``reach`` after a drift of ``SPIN_DRIFT`` times its own radius, so that it can still be
-        pushed back from every side. Always, without ``reach``."""
-        if self.reach is None:
-            return True
-        drift = SPIN_DRIFT * (self.radius[state] - self.clearance)
-        return math.hypot(x, y) + self.radius[state] + drift <= self.reach
-
-    def _turn_spot(self, state: int, start, end) -> tuple[float, float] | None:
-        """Where to turn from ``start``'s yaw to ``end``'s when the path's own turn has no room to drift.
-
-        The start itself where it has room to spin (:meth:`spin_room`) and is free at both yaws and half-way;
-        else the place (1 cm grid over the workspace) that has, with the shortest way from the start through
-        it to the end, plus ``TURN_SPOT_MOVE_COST`` for moving at all: a spot a push short of the start would
-        be overshot (pushes move 5-9 cm) and pushed back to, over and over. ``None`` where there is none.
-        """
-        checker = self.checkers[state]
-        yaws = (start[2], end[2], start[2] + 0.5 * float(wrap_angle(end[2] - start[2])))
-
-        def room(px: float, py: float) -> bool:
-            return self.spin_room(state, px, py) and all(checker.is_free(px, py, a) for a in yaws)
-
-        if room(start[0], start[1]):
-            return float(start[0]), float(start[1])
-        return _grid_argmin(self.workspace, lambda px, py: math.hypot(px - end[0], py - end[1])
-                            + math.hypot(px - start[0], py - start[1]) + TURN_SPOT_MOVE_COST, room)
 
     def _steps(self, state: int, start: tuple[float, float, float], calls) -> list[Step]:
         steps: list[Step] = []
@@ -624,70 +523,6 @@ class Planner:
              for yaw in (start[2], goal[2])])
         return bool(p_goal >= p_start)
 
-    def _free_yaw(self, state: int, xy, prefer: float) -> float:
-        """The yaw nearest ``prefer`` (5 deg steps either way, all round) at which ``state`` is free at ``xy``.
-
-        All round: an object near the arm's reach may be free at a few yaws only (the goal check found one).
-        """
-        checker = self.checkers[state]
-        for d in FREE_YAW_STEPS:
-            if checker.is_free(xy[0], xy[1], prefer + d):
-                return float(wrap_angle(prefer + d))
-        raise PlanningError(f"no free orientation of resting state {state} at {tuple(np.round(xy, 3))}")
-
-    def _nearest_free(self, state: int, cur, toward) -> tuple[float, float]:
-        """Where to push an object that is not free at ``cur`` (x, y, yaw), at its yaw: of the free positions
-        (5 mm rings) at most ``FREE_SEARCH_SLACK`` farther than the nearest, one the push to which is not avoided
-        (:meth:`_avoided`: no room for the fingertip, or failed twice), and of those the one nearest ``toward``
-        (x, y: where the segment goes). A die pressed against a block, its goal along the block, was pushed off
-        it on the side nearest by a hair, away from the goal and out of the arm's reach."""
-        T = state_pose(self.obj, state, *cur)
-        found: list[tuple[bool, float, float, float]] = []  # (avoided, distance to toward, x, y)
-        first = None
-        for r in np.arange(0.005, 0.3, 0.005):
-            if first is not None and r > first + FREE_SEARCH_SLACK:
-                break
-            for a in np.linspace(-math.pi, math.pi, max(8, int(2 * math.pi * r / 0.005)), endpoint=False):
-                px, py = cur[0] + r * math.cos(a), cur[1] + r * math.sin(a)
-                if self.checkers[state].is_free(px, py, cur[2]):
-                    first = r if first is None else first
-                    found.append((self._avoided("push", {"direction": float(a)}, T),
-                                  math.hypot(px - toward[0], py - toward[1]), float(px), float(py)))
-        if not found:
-            raise PlanningError(f"the object is stuck at {tuple(np.round(cur[:2], 3))}: no free position nearby")
-        _, _, px, py = min(found)
-        return px, py
-
-    def _roll_spot(self, a: int, b: int, cur, goal: Goal, late: bool = False) -> tuple[float, float]:
-        """Nearest place, to the object (``cur``: x, y, yaw) or with ``late`` to the goal, where a roll from
-        state ``a`` to ``b`` has room.
-
-        The room is a disc around the object, clear of obstacles. A disc inside the workspace is preferred
-        (rolls near its edge drift out of it); where no such spot exists (a big object among obstacles),
-        the disc may reach over the edge while the object's own footprint stays inside.
-        """
-        r = max(self.radius[a], self.radius[b]) + self.roll_margin
-        disc = _disc(r, 16)
-        ws = self.workspace
-        grown = Workspace(x=(ws.x[0] - r, ws.x[1] + r), y=(ws.y[0] - r, ws.y[1] + r))
-        near = (goal.xy[0], goal.xy[1], cur[2]) if late else cur
-        for room in (FootprintChecker(disc, self.obstacles, ws), FootprintChecker(disc, self.obstacles, grown)):
-            spot = self._nearest_room(room, a, near, goal)
-            if spot is not None:
-                return spot
-        raise PlanningError(f"no room anywhere in the workspace to roll from state {a} to state {b}")
-
-    def _nearest_room(self, room: FootprintChecker, a: int, cur, goal: Goal) -> tuple[float, float] | None:
-        """Where to roll: the object's own place when it has room, else the free spot (1 cm grid) nearest the
-        object and then the goal."""
-        if room.is_free(cur[0], cur[1], 0.0) and self.checkers[a].is_free(*cur) and not self.memory.spoiled(*cur[:2]):
-            return float(cur[0]), float(cur[1])
-        return _grid_argmin(self.workspace,
-                            lambda px, py: math.hypot(px - cur[0], py - cur[1])
-                            + 0.5 * math.hypot(px - goal.xy[0], py - goal.xy[1]),
-                            lambda px, py: room.is_free(px, py, 0.0) and self.checkers[a].is_free(px, py, cur[2])
-                            and not self.memory.spoiled(px, py))
-
 
 @dataclass
 class Plan:
@@ -717,7 +552,7 @@ class Plan:
     # until 0.24)
     expected_primitives: float = float("nan")
     p_steps: float = float("nan")
-    aim: Goal | None = None  # the free part of the goal's region the steps lead to (Planner.aim); None: the goal
+    aim: Goal | None = None  # the free part of the goal's region the steps lead to (Places.aim); None: the goal
 
     def __str__(self) -> str:
         if self.kind == "greedy":

@@ -68,10 +68,10 @@ def test_turns_near_the_reach_edge_are_made_where_a_drift_can_still_be_pushed_ba
     goal = ap.Goal(xy=(0.68, 0.0), yaw=math.radians(40.0), resting_state=0, yaw_symmetric=False)
     T0 = cube.resting_states[0].pose((0.67, 0.0), 0.0)
     planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
-    assert not planner.spin_room(0, 0.67, 0.0) and planner.spin_room(0, 0.6, 0.0)
+    assert not planner.places.spin_room(0, 0.67, 0.0) and planner.places.spin_room(0, 0.6, 0.0)
     plan = planner.plan(T0, goal)
     spins = [s for s in plan.steps if s.skill == "spin"]
-    assert spins and all(planner.spin_room(0, s.start_pose[0, 3], s.start_pose[1, 3]) for s in spins)
+    assert spins and all(planner.places.spin_room(0, s.start_pose[0, 3], s.start_pose[1, 3]) for s in spins)
     assert all(planner.checkers[0].is_free(*cube.planar_pose(s.expected_pose)[1:]) for s in plan.steps)
     sim = ap.Simulator(cube, seed=0)
     sim.set_object_pose(plan.start_pose, settle=False)
