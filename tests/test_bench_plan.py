@@ -128,3 +128,21 @@ def test_fit_stuck_fits_training_runs_only():
     assert fit["held_out"]["brier"] == pytest.approx(fit["brier"], abs=0.02)
     with pytest.raises(InputError, match="training"):
         fit_stuck([dict(objects="mixed", max_primitives=40, tasks=tasks)])
+
+
+def test_the_bench_scores_a_plans_odds_within_the_budget_it_executes_with():
+    """A plan's ``p_success`` is for the planner's 60 primitives; a bench run executing with 4 reports (and scores
+    the calibration of) the odds within 4."""
+    from affordplan.app.bench.plan import bench_plan, task_seed
+    from planner.odds import mc_odds
+    from primitives.outcome_model import OutcomeModel
+
+    report = bench_plan(50, sim="finger", seed=2, planners=("affordplan",), max_primitives=4, progress=False,
+                        only=[3])
+    (result,) = report.results
+    models = {name: OutcomeModel.load(name) for name in ("push", "roll", "spin")}
+    within = {b: mc_odds(result.steps, models, b, seed=task_seed(2, 3)) for b in (4, 60)}
+    assert len(result.steps) >= 3
+    assert result.p_success == pytest.approx(within[4].p_success)
+    assert result.expected_primitives == pytest.approx(within[4].expected_primitives)
+    assert within[4].p_success < within[60].p_success

@@ -74,7 +74,8 @@ class TaskResult:
     # more than the goal's tolerance) or "yaw" (in place, turned wrong); "" on success
     missed: str = ""
     task: int = -1  # index of the task in its seed's draw (object OBJECTS_PER_SEED * seed + task)
-    # the first plan's predicted odds (Plan.p_success, Plan.expected_primitives); nan for greedy or no plan
+    # the first plan's predicted odds within the execution's budget (Plan.odds(max_primitives): Plan.p_success and
+    # Plan.expected_primitives where the budget is the planner's own); nan for greedy or no plan
     p_success: float = float("nan")
     expected_primitives: float = float("nan")
     max_planning_time: float = float("nan")  # the longest of the first plan and the replans, seconds
@@ -247,8 +248,10 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
     xy_error, yaw_error, state_ok = goal.errors(obj, ex.final_pose)
     missed = "" if ex.success else "state" if not state_ok else "position" if xy_error > goal.xy_tol else "yaw"
     longest = max(ex.plan_times) if planner_name == "affordplan" and ex.plan_times else float("nan")
-    predicted = (float(p.p_success), float(p.expected_primitives)) if planner_name == "affordplan" else (
-        float("nan"), float("nan"))
+    predicted = (float("nan"), float("nan"))
+    if planner_name == "affordplan":  # the odds within this execution's budget, not the planner's default 60
+        odds = p.odds(max_primitives)
+        predicted = (float(odds.p_success), float(odds.expected_primitives))
     return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal,
                       float(xy_error), float(yaw_error), missed, p_success=predicted[0],
                       expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name,
