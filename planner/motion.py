@@ -103,6 +103,8 @@ class FootprintChecker:
         self.reach = reach
         self._vertices = [(float(px), float(py)) for px, py in polygon]
         self._radius = float(np.max(np.hypot(polygon[:, 0], polygon[:, 1])))  # circumscribed about the origin
+        near = self._radius + BROAD_PHASE_SLACK
+        self._near2 = near * near  # a box farther than this (squared) from the pose is not hit (colliding)
         # Poses whose circumscribed disc lies inside the workspace skip the per-vertex test.
         self._inner = (workspace.x[0] + self._radius, workspace.x[1] - self._radius,
                        workspace.y[0] + self._radius, workspace.y[1] - self._radius)
@@ -152,13 +154,12 @@ class FootprintChecker:
         """Indices of the obstacles the footprint at ``(x, y, yaw)`` overlaps (only the first if ``first``)."""
         hits = []
         posed = False
-        near = self._radius + BROAD_PHASE_SLACK
         for i, (cx, cy, c, s, hx, hy) in enumerate(self._obstacle_boxes):
             # the footprint lies within its circumscribed radius of (x, y): a box farther than that is not hit
             dx, dy = x - cx, y - cy
             ex = max(abs(c * dx + s * dy) - hx, 0.0)  # (x, y) outside the box, along its axes, metres
             ey = max(abs(c * dy - s * dx) - hy, 0.0)
-            if ex * ex + ey * ey > near * near:
+            if ex * ex + ey * ey > self._near2:
                 continue
             if not posed:
                 self._set_pose(x, y, yaw)

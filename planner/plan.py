@@ -64,9 +64,8 @@ SPLIT_ANGLE = math.radians(35.0)
 # push must itself not have failed twice, or the plan would repeat a failure under another name.
 DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  # never backwards
 # A goal yaw is reached before the last roll, where spinning is likelier to succeed, when the success
-# model rates a 30 deg spin there this much higher than in the goal's resting state (a frustum on its
-# side, say, cannot be spun; on its base it can).
-# (the 30 deg spin is planner.ratings.TURN_PROBE_ANGLE)
+# model rates a 30 deg spin (planner.ratings.TURN_PROBE_ANGLE) there this much higher than in the goal's
+# resting state (a frustum on its side, say, cannot be spun; on its base it can).
 TURN_BEFORE_MARGIN = 0.15
 # Where the goal's resting state spins this badly (predicted, or spins there failed twice) and no roll into
 # it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
