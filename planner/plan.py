@@ -193,11 +193,26 @@ class Planner:
     def odds(self, steps: Sequence[Step], budget: int) -> Odds:
         """The odds of ``steps`` within ``budget`` primitives under closed-loop execution: by Monte Carlo through the
         skills' outcome models where the predictor has them (:func:`planner.odds.mc_odds`, seeded by the planner's
-        seed), else each step retried with its strict probability (:func:`planner.odds.plan_odds`)."""
+        seed; each step with its tip probability, :meth:`odds_steps`), else each step retried with its strict
+        probability (:func:`planner.odds.plan_odds`)."""
         outcomes = getattr(self.predictor, "outcomes", None)
         if outcomes and all(s.skill in outcomes for s in steps):
-            return mc_odds([(s.skill, s.p_success) for s in steps], outcomes, budget, seed=self.seed)
+            return mc_odds(self.odds_steps(steps), outcomes, budget, seed=self.seed)
         return plan_odds([s.p_success for s in steps], budget)
+
+    def odds_steps(self, steps: Sequence[Step]) -> list[tuple[str, float, float]]:
+        """Each step as :func:`planner.odds.mc_odds` reads it: ``(skill, strict p, tip)``, ``tip`` the probability
+        that one try leaves the object in another resting state, from the skill's outcome model and the drop
+        probability of the state the step starts in (:meth:`primitives.outcome_model.OutcomeModel.p_tip`; 0 without
+        outcome models)."""
+        outcomes = getattr(self.predictor, "outcomes", None) or {}
+        out = []
+        for s in steps:
+            model, tip = outcomes.get(s.skill), 0.0
+            if model is not None and getattr(model, "knows_tips", False):
+                tip = model.p_tip(self.obj.resting_states[self.obj.classify(s.start_pose)].probability)
+            out.append((s.skill, float(s.p_success), float(tip)))
+        return out
 
     # ------------------------------------------------------------------ queries
     def record_failure(self, skill: str, params: dict, T_world_object: np.ndarray) -> int:

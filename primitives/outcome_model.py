@@ -16,17 +16,25 @@ left the object in another resting state counts 0.
 :meth:`OutcomeModel.sample_progress` resamples their progress; :meth:`OutcomeModel.p_progress` is the share of
 them that made progress (:func:`primitives.params.made_progress`'s criterion).
 
-**Limits**: it conditions on ``p_strict`` only. The parameter is marginalised over the planner's distribution
-(push direction: irrelevant by the table's symmetry; spin ``|angle|`` between 15 and 45 deg; roll target), and so
-is the object (the collection's objects: procedural training objects and HACMan's training meshes), the start pose
-and the sensor's noise. Successive calls on one object are treated as independent draws, though a call that failed
-on an object is likelier to fail again. A few hundred rollouts resolve the distribution coarsely, least well at
-high ``p`` where few rollouts lie (the ``k`` nearest then reach down to lower ``p``). ``python -m
-primitives.training.outcomes check`` measures the intervals' coverage on unseen objects.
+**Tips** (:meth:`OutcomeModel.p_tip`): a push or a spin may leave the object in another resting state (a hard drive
+stood on its edge falls flat). Where the file records each rollout's start state's drop probability (the column
+``state_probability``: the share of random drops that come to rest in that state), the model gives the share of the
+``k`` rollouts nearest in log drop probability whose call ended in another state: a state few drops rest in is one a
+push easily knocks over (on the training collection: 25 % of pushes in states rarer than 0.13, none above 0.52).
+
+**Limits**: progress conditions on ``p_strict`` only, tips on the drop probability only. The parameter is
+marginalised over the planner's distribution (push direction: irrelevant by the table's symmetry; spin ``|angle|``
+between 15 and 45 deg; roll target), and so is the object (the collection's objects: procedural training objects and
+HACMan's training meshes), the start pose and the sensor's noise. Successive calls on one object are treated as
+independent draws, though a call that failed on an object is likelier to fail again. A few hundred rollouts resolve
+the distribution coarsely, least well at high ``p`` where few rollouts lie (the ``k`` nearest then reach down to
+lower ``p``). ``python -m primitives.training.outcomes check`` measures the intervals' coverage, and the tip rate,
+on unseen objects.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import zipfile
 from pathlib import Path
@@ -39,6 +47,7 @@ from primitives.weights_file import SHIPPED_DIR
 
 DEFAULT_K = 60  # rollouts nearest in p that a query resamples
 REQUIRED = ("p", "progress", "made_progress")
+TIP_COLUMNS = ("state_probability", "state_before", "state_after")  # what p_tip needs; older files lack the first
 
 
 class OutcomeModel:
@@ -51,9 +60,13 @@ class OutcomeModel:
         progress: ``(m,)`` the share of the asked effect each achieved.
         made_progress: ``(m,)`` bools; default ``progress >= 1`` for roll, ``progress > 0`` otherwise.
         k: rollouts nearest in ``p`` that a query takes (capped at ``m``).
+        state_probability: ``(m,)`` drop probability of each rollout's start state, in (0, 1]; with ``tipped``,
+            what :meth:`p_tip` reads. ``None``: the model knows nothing of tips (``p_tip`` is 0).
+        tipped: ``(m,)`` bools, the call ended in another resting state than it started in.
     """
 
-    def __init__(self, skill: str, p, progress, made_progress=None, k: int = DEFAULT_K):
+    def __init__(self, skill: str, p, progress, made_progress=None, k: int = DEFAULT_K, state_probability=None,
+                 tipped=None):
         if skill not in SKILLS:
             raise InputError(f"unknown skill {skill!r}; expected one of {SKILLS}")
         p = np.asarray(p, dtype=float).reshape(-1)
@@ -71,6 +84,26 @@ class OutcomeModel:
         self.skill = skill
         self.p, self.progress, self.made_progress = p[order], progress[order], made[order]
         self.k = min(int(k), len(p))
+        # tips, sorted by log drop probability (None: unknown)
+        self._tip_log_prob: np.ndarray | None = None
+        self._tipped: np.ndarray | None = None
+        if (state_probability is None) != (tipped is None):
+            raise InputError("an outcome model needs both state_probability and tipped, or neither")
+        if state_probability is not None:
+            sp = np.asarray(state_probability, dtype=float).reshape(-1)
+            tip = np.asarray(tipped, dtype=bool).reshape(-1)
+            if not (len(sp) == len(tip) == len(p)):
+                raise InputError(f"state_probability and tipped need one value per rollout ({len(p)}), got "
+                                 f"{len(sp)} and {len(tip)}")
+            if not np.all(np.isfinite(sp)) or np.any(sp <= 0.0) or np.any(sp > 1.0):
+                raise InputError("an outcome model's state_probability must lie in (0, 1]")
+            by_prob = np.argsort(sp, kind="stable")
+            self._tip_log_prob, self._tipped = np.log(sp[by_prob]), tip[by_prob]
+
+    @property
+    def knows_tips(self) -> bool:
+        """Whether the model was given each rollout's drop probability and state change (:meth:`p_tip`)."""
+        return self._tipped is not None
 
     @classmethod
     def load(cls, skill: str, path: str | os.PathLike | None = None, k: int = DEFAULT_K) -> OutcomeModel:
@@ -95,6 +128,7 @@ class OutcomeModel:
                     raise WeightsError(f"{path} is not an outcome model: it has no {', '.join(missing)}")
                 stored = str(f["skill"]) if "skill" in f.files else skill
                 cols = {c: np.array(f[c]) for c in REQUIRED}
+                tips = {c: np.array(f[c]) for c in TIP_COLUMNS} if all(c in f.files for c in TIP_COLUMNS) else None
         except WeightsError:
             raise
         except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError) as exc:
@@ -102,7 +136,11 @@ class OutcomeModel:
         if stored != skill:
             raise WeightsError(f"{path} is the {stored} outcome model, not {skill}'s")
         try:
-            return cls(skill, cols["p"], cols["progress"], cols["made_progress"], k=k)
+            if tips is None:
+                return cls(skill, cols["p"], cols["progress"], cols["made_progress"], k=k)
+            return cls(skill, cols["p"], cols["progress"], cols["made_progress"], k=k,
+                       state_probability=tips["state_probability"],
+                       tipped=tips["state_before"] != tips["state_after"])
         except (InputError, ValueError, TypeError) as exc:
             raise WeightsError(f"{path} holds a damaged outcome model: {exc}") from exc
 
@@ -110,7 +148,7 @@ class OutcomeModel:
         return len(self.p)
 
     def __repr__(self) -> str:
-        return f"OutcomeModel({self.skill!r}, {len(self)} rollouts, k={self.k})"
+        return f"OutcomeModel({self.skill!r}, {len(self)} rollouts, k={self.k}{', tips' if self.knows_tips else ''})"
 
     def _check_p(self, p_strict) -> np.ndarray:
         q = np.asarray(p_strict, dtype=float)
@@ -122,16 +160,8 @@ class OutcomeModel:
         """Indices (into the sorted rollouts) of the ``k`` whose ``p`` is nearest ``p_strict``: a window of the
         sorted ``p`` (ties broken towards lower ``p``)."""
         q = float(self._check_p(p_strict))
-        m, k = len(self.p), self.k
-        # the k nearest of a sorted array form a contiguous window [lo, lo + k); choose lo by two-pointer search
-        lo = int(np.clip(np.searchsorted(self.p, q) - k, 0, m - k))
-        hi = min(lo + 2 * k, m)
-        d = np.abs(self.p[lo:hi] - q)
-        # the window of k consecutive elements with the smallest largest distance
-        if hi - lo > k:
-            worst = np.maximum(d[: hi - lo - k + 1], d[k - 1:])
-            lo += int(np.argmin(worst))
-        return np.arange(lo, lo + k)
+        window = _nearest_window(self.p, q, self.k)
+        return np.arange(window.start, window.stop)
 
     def support(self, p_strict: float) -> np.ndarray:
         """The ``k`` progress values a query for ``p_strict`` resamples (equally likely)."""
@@ -161,3 +191,32 @@ class OutcomeModel:
         q = self._check_p(p_strict)
         out = np.array([np.quantile(self.support(v), quantiles) for v in q.reshape(-1)])
         return out.reshape(*q.shape, len(quantiles))
+
+    def p_tip(self, state_probability):
+        """The probability that a call made in a resting state with drop probability ``state_probability`` (in
+        (0, 1]) leaves the object in another resting state: the share of the ``k`` rollouts nearest in log drop
+        probability that did (module docstring). 0 for a roll (changing the state is its job; a roll into the
+        wrong state is its progress of 0) and for a model that knows nothing of tips. A float, or an array for an
+        array."""
+        q = np.asarray(state_probability, dtype=float)
+        if not np.all(np.isfinite(q)) or np.any(q <= 0.0) or np.any(q > 1.0):
+            raise InputError(f"state_probability must lie in (0, 1], got {np.round(q, 3).tolist()}")
+        if self.skill == "roll" or self._tipped is None:
+            out = np.zeros(q.shape)
+        else:
+            keys, k = self._tip_log_prob, min(self.k, len(self._tipped))
+            out = np.array([self._tipped[_nearest_window(keys, math.log(v), k)].mean() for v in q.reshape(-1)])
+            out = out.reshape(q.shape)
+        return float(out) if out.ndim == 0 else out
+
+
+def _nearest_window(sorted_values: np.ndarray, x: float, k: int) -> slice:
+    """The ``k`` consecutive entries of ``sorted_values`` nearest ``x`` (the window whose farthest entry is nearest;
+    ties towards lower values)."""
+    m = len(sorted_values)
+    lo = int(np.clip(np.searchsorted(sorted_values, x) - k, 0, m - k))
+    hi = min(lo + 2 * k, m)
+    d = np.abs(sorted_values[lo:hi] - x)
+    if hi - lo > k:
+        lo += int(np.argmin(np.maximum(d[: hi - lo - k + 1], d[k - 1:])))
+    return slice(lo, lo + k)

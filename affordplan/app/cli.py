@@ -174,11 +174,12 @@ def _cmd_bench_fit_stuck(args: argparse.Namespace) -> int:
         return 0
     rates = ", ".join(f"{skill} {rate:.1f}" for skill, rate in fit["rates"].items())
     print(f"fitted on {fit['plans']} plans on training objects ({fit['reached']:.2f} reached): stuck rates {rates}; "
-          f"Brier of p_success {fit['brier']:.3f} (without stuck steps {fit['brier_without']:.3f})")
+          f"fatal tips {fit['tip_fatal']:.1f}; Brier of p_success {fit['brier']:.3f} (without stuck steps or tips "
+          f"{fit['brier_without']:.3f})")
     if "held_out" in fit:
         h = fit["held_out"]
         print(f"held out, {h['plans']} plans ({h['reached']:.2f} reached): Brier {h['brier']:.3f} "
-              f"(without stuck steps {h['brier_without']:.3f})")
+              f"(without stuck steps or tips {h['brier_without']:.3f})")
     return 0
 
 
@@ -512,11 +513,14 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     bf = bench_sub.add_parser(
-        "fit-stuck", help="fit the planner's stuck rates to saved `bench plan --objects training --json` runs",
+        "fit-stuck", help="fit the planner's stuck rates and fatal-tip share to saved `bench plan --objects training "
+                          "--json` runs",
         formatter_class=_formatter,
         description=_wrap("Fit planner.odds.STUCK_RATES, per skill the share of a step's predicted failure "
-                          "that is systematic (no retry succeeds), to the first plans of saved plan-bench runs on "
-                          "training objects: the rates whose predicted p_success has the least Brier score."),
+                          "that is systematic (no retry succeeds), and planner.odds.TIP_FATAL, the share of tips "
+                          "(a push or spin that leaves the object in another resting state) a run does not recover "
+                          "from, to the first plans of saved plan-bench runs on training objects: the values whose "
+                          "predicted p_success has the least Brier score."),
         epilog="example:\n  affordplan bench plan --objects training --sim finger --planner affordplan --seed 100 "
                "--json > runs/train100.json\n"
                "  affordplan bench fit-stuck runs/train100.json --held-out runs/train101.json")

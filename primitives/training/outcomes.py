@@ -24,7 +24,14 @@ recording per row (:data:`COLUMNS`):
 - ``dx, dy, dyaw``: the SE(2) displacement (push: in the asked direction's frame, ``dx`` along it; otherwise the
   world frame; metres, radians; ``dyaw`` from the resting state's yaw, 0 when the state changed);
 - ``state_before``, ``state_after``, ``state_asked`` (roll's target, else the start state), ``valid``,
-  ``object`` (an index into the file's ``objects`` names).
+  ``object`` (an index into the file's ``objects`` names);
+- ``state_probability``: the drop probability of ``state_before`` (what the outcome model's tip rate,
+  :meth:`primitives.outcome_model.OutcomeModel.p_tip`, is conditioned on).
+
+**annotate**: adds ``state_probability`` to files collected before it was recorded, from their ``objects`` and
+``state_before`` (every other column is kept as it was):
+
+    python -m primitives.training.outcomes annotate primitives/weights/push_outcome.npz
 
 The file is a plain ``.npz`` (``np.load(..., allow_pickle=False)`` reads it): the columns, ``objects``, and the
 strings ``skill``, ``objects_spec``, ``command``.
@@ -83,8 +90,10 @@ import math
 import shlex
 import sys
 import time
+import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -103,7 +112,7 @@ from primitives.training.env import EnvConfig, _lru, object_groups
 COLUMNS = {  # name: dtype
     "p": np.float32, "param": np.float32, "success": bool, "made_progress": bool, "progress": np.float32,
     "dx": np.float32, "dy": np.float32, "dyaw": np.float32, "state_before": np.int16, "state_after": np.int16,
-    "state_asked": np.int16, "valid": bool, "object": np.int16,
+    "state_asked": np.int16, "valid": bool, "object": np.int16, "state_probability": np.float32,
 }
 
 
@@ -140,6 +149,43 @@ def draw_params(skill: str, rng: np.random.Generator, obj: ObjectModel, state: i
 
 def object_name(key) -> str:
     return f"{key[0]}/{key[1]}" if isinstance(key, tuple) else str(key)
+
+
+def object_of(name: str) -> ObjectModel:
+    """The object a file's ``objects`` entry names (:func:`object_name`): ``"train/485"`` (a procedural split and
+    index) or a catalogue or household name."""
+    split, _, index = name.partition("/")
+    if split in ("train", "test") and index.isdigit():
+        return random_object(int(index), split)
+    return load_object(name)
+
+
+def annotate(path: str, progress: bool = True) -> dict:
+    """Add ``state_probability`` (module docstring) to the outcome file ``path``, in place (written to a temporary
+    file beside it, then moved over it, so an interrupted run loses nothing). Returns what it wrote."""
+    src = Path(path)
+    if not src.is_file():
+        raise InputError(f"no outcome file at {str(path)!r}")
+    with np.load(src, allow_pickle=False) as f:
+        data = {k: np.array(f[k]) for k in f.files}
+    missing = [c for c in ("objects", "object", "state_before") if c not in data]
+    if missing:
+        raise InputError(f"{path} cannot be annotated: it has no {', '.join(missing)}")
+    names = [str(n) for n in data["objects"]]
+    probability = np.zeros(len(data["object"]), dtype=np.float32)
+    for i in tqdm(range(len(names)), desc=f"annotate {src.name}", disable=not progress, unit="object"):
+        rows = np.flatnonzero(data["object"] == i)
+        if len(rows):
+            with warnings.catch_warnings():  # load_object's "far outside what the skills trained on": not news here
+                warnings.simplefilter("ignore", UserWarning)
+                obj = object_of(names[i])
+            probability[rows] = [obj.resting_states[int(s)].probability for s in data["state_before"][rows]]
+    data["state_probability"] = probability
+    tmp = src.with_name(src.name + ".tmp.npz")
+    np.savez_compressed(tmp, **data)
+    tmp.replace(src)
+    tipped = data["state_before"] != data["state_after"]
+    return dict(file=str(src), rows=int(len(probability)), objects=len(names), tipped=float(tipped.mean()))
 
 
 def collect(skill: str, skills: Mapping[str, Skill], rollouts: int, objects: str = "train+housekeep:training",
@@ -180,7 +226,8 @@ def collect(skill: str, skills: Mapping[str, Skill], rollouts: int, objects: str
         out = skills[skill].execute(sim, params)
         m = measure(obj, skill, params, out.pose_before, out.pose_after)
         row = dict(m, p=p, param=next(iter(params.values())), success=bool(out.success), valid=bool(out.valid),
-                   object=names.setdefault(object_name(key), len(names)))
+                   object=names.setdefault(object_name(key), len(names)),
+                   state_probability=states[m["state_before"]].probability)
         for k in COLUMNS:
             rows[k].append(row[k])
         bar.update(1)
@@ -201,7 +248,8 @@ def save(path: str, data: Mapping[str, np.ndarray], skill: str, objects: str, co
 
 def check(model, data: Mapping[str, np.ndarray], lo: float = 0.1, hi: float = 0.9) -> dict:
     """How well ``model`` (:class:`primitives.outcome_model.OutcomeModel`) predicts the rows ``data``: coverage of
-    its ``lo``-``hi`` progress interval, mean predicted vs measured progress, and ``p_progress``'s accuracy."""
+    its ``lo``-``hi`` progress interval, mean predicted vs measured progress, ``p_progress``'s accuracy, and (push,
+    spin) the tip rate predicted against the share of calls that left their resting state."""
     p = np.asarray(data["p"], dtype=float)
     progress = np.asarray(data["progress"], dtype=float)
     made = np.asarray(data["made_progress"], dtype=bool)
@@ -218,6 +266,11 @@ def check(model, data: Mapping[str, np.ndarray], lo: float = 0.1, hi: float = 0.
                strict_p_mean=float(p.mean()), strict_success=float(np.mean(data["success"])),
                strict_p_brier=float(np.mean((p - np.asarray(data["success"], dtype=float)) ** 2)),
                invalid=int(np.sum(~np.asarray(data["valid"], dtype=bool))))
+    if model.knows_tips and model.skill != "roll":  # the tip rate against the calls that left their state
+        tipped = np.asarray(data["state_before"]) != np.asarray(data["state_after"])
+        pt = model.p_tip(np.asarray(data["state_probability"], dtype=float))
+        out.update(predicted_tipped=float(pt.mean()), measured_tipped=float(tipped.mean()),
+                   p_tip_brier=float(np.mean((pt - tipped) ** 2)))
     if model.skill == "roll":  # progress is made_progress: report p_progress's calibration in bins
         bins = np.linspace(0.0, 1.0, 6)
         which = np.clip(np.digitize(pp, bins) - 1, 0, len(bins) - 2)
@@ -230,6 +283,8 @@ def check(model, data: Mapping[str, np.ndarray], lo: float = 0.1, hi: float = 0.
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m primitives.training.outcomes", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
+    a = sub.add_parser("annotate", help="add state_probability to outcome files collected before it was recorded")
+    a.add_argument("files", nargs="+")
     for name in ("collect", "check"):
         s = sub.add_parser(name)
         s.add_argument("skill", choices=SKILLS)
@@ -250,6 +305,14 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     cli_logging()
+    if args.command == "annotate":
+        try:
+            for path in args.files:
+                print(json.dumps(annotate(path)))
+        except (AffordplanError, OSError, ValueError) as exc:
+            print(f"primitives.training.outcomes: error: {exc}", file=sys.stderr)
+            return 2
+        return 0
     if args.rollouts < 1:
         parser.error("--rollouts must be a positive integer")
     if args.command == "collect" and args.out is None:

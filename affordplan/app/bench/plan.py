@@ -255,7 +255,7 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
     return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal,
                       float(xy_error), float(yaw_error), missed, p_success=predicted[0],
                       expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name,
-                      steps=[(s.skill, float(s.p_success)) for s in p.steps] if planner_name == "affordplan" else [])
+                      steps=p.planner.odds_steps(p.steps) if planner_name == "affordplan" else [])
 
 
 def _describe(task: Task) -> str:
@@ -329,9 +329,10 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
 
 
 def _training_plans(reports: Sequence[dict], training: bool = True
-                    ) -> tuple[list[list[tuple[str, float]]], list[bool], int]:
-    """The affordplan first plans' steps, whether each reached, and the runs' execution budget, from saved bench
-    runs (on training objects, unless ``training`` is false)."""
+                    ) -> tuple[list[list[tuple[str, float, float]]], list[bool], int]:
+    """The affordplan first plans' steps (``(skill, p, tip)``; runs saved before tips were recorded give tip 0),
+    whether each reached, and the runs' execution budget, from saved bench runs (on training objects, unless
+    ``training`` is false)."""
     plans, reached, budgets = [], [], set()
     for report in reports:
         if training and report.get("objects") != "training":
@@ -340,7 +341,8 @@ def _training_plans(reports: Sequence[dict], training: bool = True
         budgets.add(int(report["max_primitives"]))
         for task in report["tasks"]:
             if task["planner"] == "affordplan" and task.get("steps"):
-                plans.append([(skill, float(p)) for skill, p in task["steps"]])
+                plans.append([(step[0], float(step[1]), float(step[2]) if len(step) > 2 else 0.0)
+                              for step in task["steps"]])
                 reached.append(bool(task["success"]))
     if not plans:
         raise InputError("no affordplan plans with steps in these runs")
@@ -350,31 +352,35 @@ def _training_plans(reports: Sequence[dict], training: bool = True
 
 
 def fit_stuck(reports: Sequence[dict], held_out: Sequence[dict] = (), grid_step: float = 0.1, seed: int = 0) -> dict:
-    """Fit :data:`planner.odds.STUCK_RATES` to the affordplan plans of saved bench runs (``BenchReport.as_dict``, as
-    ``affordplan bench plan --objects training --json`` prints it): the rates whose first-plan ``p_success``
-    (:func:`planner.odds.mc_odds` through the shipped outcome models, the runs' execution budget) has the least
-    Brier score against whether the goal was reached (:func:`planner.odds.fit_stuck_rates`). ``held_out``: other
-    runs, on any objects (scored, never fitted on), scored with the fitted rates and without stuck steps.
+    """Fit :data:`planner.odds.STUCK_RATES` and :data:`planner.odds.TIP_FATAL` to the affordplan plans of saved
+    bench runs (``BenchReport.as_dict``, as ``affordplan bench plan --objects training --json`` prints it): the
+    values whose first-plan ``p_success`` (:func:`planner.odds.mc_odds` through the shipped outcome models, the runs'
+    execution budget) has the least Brier score against whether the goal was reached (:func:`planner.odds.fit_odds`).
+    ``held_out``: other runs, on any objects (scored, never fitted on), scored with the fitted values and with
+    neither stuck steps nor tips.
 
-    Returns ``dict(rates, plans, reached, brier, brier_without)``, with ``held_out=dict(plans, reached, brier,
-    brier_without)`` when given.
+    Returns ``dict(rates, tip_fatal, plans, reached, brier, brier_without)``, with ``held_out=dict(plans, reached,
+    brier, brier_without)`` when given.
 
     Raises:
         InputError: a run on objects other than the training ones (held-out objects are never fitted on), or no
             affordplan plans with their steps.
     """
-    from planner.odds import fit_stuck_rates, mc_odds
+    from planner.odds import fit_odds, mc_odds
     from primitives.outcome_model import OutcomeModel
 
     plans, reached, budget = _training_plans(reports)
     models = {name: OutcomeModel.load(name) for name in SKILLS}
     grid = np.round(np.arange(0.0, 1.0 + 1e-9, grid_step), 6)
-    rates, brier, without = fit_stuck_rates(plans, reached, models, budget=budget, grid=grid, seed=seed)
-    fit = dict(rates=rates, plans=len(plans), reached=float(np.mean(reached)), brier=brier, brier_without=without)
+    rates, fatal, brier, without = fit_odds(plans, reached, models, budget=budget, grid=grid, fatal_grid=grid,
+                                            seed=seed)
+    fit = dict(rates=rates, tip_fatal=fatal, plans=len(plans), reached=float(np.mean(reached)), brier=brier,
+               brier_without=without)
     if held_out:
         plans, reached, budget = _training_plans(held_out, training=False)
         y = np.asarray(reached, dtype=float)
-        scores = [float(np.mean((np.array([mc_odds(steps, models, budget, seed=seed, stuck_rate=r).p_success
-                                           for steps in plans]) - y) ** 2)) for r in (rates, 0.0)]
+        scores = [float(np.mean((np.array([mc_odds(steps, models, budget, seed=seed, stuck_rate=r,
+                                                   tip_fatal=f).p_success for steps in plans]) - y) ** 2))
+                  for r, f in ((rates, fatal), (0.0, 0.0))]
         fit["held_out"] = dict(plans=len(plans), reached=float(y.mean()), brier=scores[0], brier_without=scores[1])
     return fit
