@@ -223,3 +223,51 @@ def test_the_shipped_stuck_rates_make_a_doubtful_roll_a_doubtful_plan():
     shipped = mc_odds([("roll", 0.5)], models, budget=200, n=20_000)
     assert shipped.p_success == pytest.approx(1.0 - STUCK_RATES["roll"] * 0.5, abs=0.015)
     assert mc_odds([("roll", 0.5)], models, budget=200, n=20_000, stuck_rate=0.0).p_success > 0.99
+
+
+# ------------------------------------------------------------------ tips
+def test_a_step_that_cannot_tip_keeps_its_odds_exactly():
+    models = {"push": _model("push"), "roll": _model("roll"), "spin": _model("spin")}
+    pairs = [("push", 0.3), ("roll", 0.6), ("spin", 0.5)]
+    triples = [(k, p, 0.0) for k, p in pairs]
+    assert mc_odds(pairs, models, budget=30, seed=2) == mc_odds(triples, models, budget=30, seed=2)
+
+
+def test_a_fatal_tip_loses_the_run_on_each_try():
+    """Two pushes that always achieve their step, each try lost with probability t: the run survives 1 - t twice."""
+    steps = [("push", 0.5, 0.3), ("push", 0.5, 0.3)]
+    odds = mc_odds(steps, {"push": Constant(1.0)}, budget=20, n=20_000, stuck_rate=0.0, tip_fatal=1.0)
+    assert odds.p_success == pytest.approx(0.7 ** 2, abs=0.015)
+    half = mc_odds(steps, {"push": Constant(1.0)}, budget=20, n=20_000, stuck_rate=0.0, tip_fatal=0.5)
+    assert half.p_success == pytest.approx(0.85 ** 2, abs=0.015)
+    assert mc_odds(steps, {"push": Constant(1.0)}, budget=20, stuck_rate=0.0, tip_fatal=0.0).p_success == 1.0
+
+
+def test_slow_steps_risk_a_tip_on_every_try():
+    """A push achieving half its step takes two tries, so it risks two tips."""
+    one = mc_odds([("push", 0.5, 0.2)], {"push": Constant(0.5)}, budget=20, n=20_000, stuck_rate=0.0, tip_fatal=1.0)
+    assert one.p_success == pytest.approx(0.8 ** 2, abs=0.015)
+
+
+@pytest.mark.parametrize("steps,kwargs", [([("push", 0.5, 1.5)], {}), ([("push", 0.5, math.nan)], {}),
+                                          ([("push", 0.5, 0.1, 0.2)], {}), ([("push", 0.5, 0.1)], {"tip_fatal": 2.0})])
+def test_bad_tips_are_refused(steps, kwargs):
+    with pytest.raises(InputError, match="tip"):
+        mc_odds(steps, {"push": Constant(1.0)}, budget=10, **kwargs)
+
+
+def test_fit_odds_recovers_the_fatal_share_of_tips():
+    from planner.odds import fit_odds
+
+    rng = np.random.default_rng(5)
+    models = {"push": Constant(1.0)}
+    plans, reached = [], []
+    for _ in range(400):
+        steps = [("push", 0.5, float(rng.choice([0.0, 0.5]))) for _ in range(int(rng.integers(1, 4)))]
+        plans.append(steps)
+        reached.append(bool(rng.random() < np.prod([1.0 - 0.6 * t for _, _, t in steps])))
+    rates, fatal, brier, without = fit_odds(plans, reached, models, budget=20, grid=[0.0, 0.5, 1.0],
+                                            fatal_grid=np.linspace(0, 1, 11), n=2000)
+    assert fatal == pytest.approx(0.6, abs=0.15)
+    assert rates["push"] == 0.0  # a step that always achieves its effect is never stuck: q = 0.5 gives nothing
+    assert brier < without

@@ -139,3 +139,58 @@ def test_bad_queries_and_models_are_refused():
         OutcomeModel("slide", [0.5], [1.0])
     with pytest.raises(InputError):
         OutcomeModel("push", [], [])
+
+
+# ------------------------------------------------------------------ tips: calls that leave their resting state
+def _tip_fixture(path, skill="push", m=800, seed=0):
+    """A synthetic outcome file with tips: a call tips with probability 0.4 in states rarer than 0.1, else never."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(0.0, 1.0, m).astype(np.float32)
+    prob = np.exp(rng.uniform(np.log(0.01), 0.0, m)).astype(np.float32)
+    before = rng.integers(0, 4, m).astype(np.int16)
+    tipped = (prob < 0.1) & (rng.random(m) < 0.4)
+    np.savez_compressed(path, p=p, progress=p, made_progress=p > 0.2, skill=np.asarray(skill),
+                        state_probability=prob, state_before=before,
+                        state_after=np.where(tipped, before + 1, before).astype(np.int16))
+
+
+@pytest.mark.parametrize("skill", ["push", "spin"])
+def test_calls_in_states_few_drops_rest_in_tip_more(tmp_path, skill):
+    path = tmp_path / f"{skill}_outcome.npz"
+    _tip_fixture(path, skill)
+    model = OutcomeModel.load(skill, path)
+    assert model.knows_tips and "tips" in repr(model)
+    assert model.p_tip(0.02) == pytest.approx(0.4, abs=0.15)
+    assert model.p_tip(0.6) == 0.0
+    assert model.p_tip(np.array([0.02, 0.6])).shape == (2,)
+
+
+def test_a_roll_has_no_tip_rate_and_an_old_file_knows_no_tips(tmp_path):
+    path = tmp_path / "roll_outcome.npz"
+    _tip_fixture(path, "roll")
+    assert OutcomeModel.load("roll", path).p_tip(0.02) == 0.0  # changing state is a roll's job
+    old = tmp_path / "push_outcome.npz"
+    _fixture(old)  # no state_probability column
+    model = OutcomeModel.load("push", old)
+    assert not model.knows_tips and model.p_tip(0.02) == 0.0
+
+
+@pytest.mark.parametrize("skill", SKILLS)
+def test_the_shipped_models_know_tips(skill):
+    """The shipped files carry each rollout's drop probability: pushes in rare states tip (the hard drive on edge)."""
+    model = OutcomeModel.load(skill)
+    assert model.knows_tips
+    if skill == "push":
+        assert model.p_tip(0.03) > 0.1 > model.p_tip(0.8)
+
+
+def test_tips_need_both_columns_and_probabilities_in_zero_one():
+    with pytest.raises(InputError, match="both"):
+        OutcomeModel("push", [0.5], [1.0], state_probability=[0.5])
+    with pytest.raises(InputError, match="state_probability"):
+        OutcomeModel("push", [0.5], [1.0], state_probability=[0.0], tipped=[False])
+    model = OutcomeModel("push", [0.5], [1.0], state_probability=[0.5], tipped=[True])
+    assert model.p_tip(0.5) == 1.0
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(InputError):
+            model.p_tip(bad)

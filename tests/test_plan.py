@@ -392,3 +392,28 @@ def test_a_plan_call_solves_each_path_once_and_plans_as_if_it_solved_them_all(mo
     assert [(s.skill, s.params) for s in again.steps] == [(s.skill, s.params) for s in plan.steps]
     for (_, p1), (_, p2) in zip(plan.paths, again.paths, strict=True):
         np.testing.assert_array_equal(p1, p2)
+
+
+def test_a_plans_odds_count_the_risk_that_pushes_in_a_rare_state_tip_the_object():
+    """Pushes of the mug standing where few drops come to rest (state 2, 9 % of drops) may knock it over: the
+    plan's steps carry that tip rate, and its odds are lower than the same steps' odds with no tips."""
+    from planner.odds import mc_odds
+    from planner.predict import state_pose
+    from primitives.outcome_model import OutcomeModel
+
+    mug = ap.load_object("mug")
+    planner = ideal_planner(mug)
+    planner.predictor.outcomes = {name: OutcomeModel.load(name) for name in ("push", "roll", "spin")}
+    tips = {}
+    for state in (0, 2):
+        plan = planner.plan(state_pose(mug, state, 0.40, 0.0, 0.0), ap.Goal(xy=(0.62, 0.05), resting_state=state))
+        steps = planner.odds_steps(plan.steps)
+        assert [s[:2] for s in steps] == [(s.skill, s.p_success) for s in plan.steps]
+        tips[state] = max(t for skill, _, t in steps if skill == "push")
+        bare = mc_odds([s[:2] for s in steps], planner.predictor.outcomes, planner.budget, seed=planner.seed)
+        if state == 2:
+            assert plan.p_success < bare.p_success
+        else:
+            assert plan.p_success == bare.p_success
+    assert mug.resting_states[2].probability < 0.1 < mug.resting_states[0].probability
+    assert tips[2] > 0.1 and tips[0] == 0.0
