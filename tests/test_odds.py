@@ -215,7 +215,7 @@ def test_a_rate_per_skill_applies_to_that_skills_steps_only():
 
 
 def test_the_shipped_stuck_rates_make_a_doubtful_roll_a_doubtful_plan():
-    """With the shipped rates (roll 0.9), a roll rated 0.5 leaves a plan about 1 - 0.9 * 0.5 = 0.55 to reach its goal
+    """With the shipped rates (roll 0.6), a roll rated 0.5 leaves a plan about 1 - 0.6 * 0.5 = 0.7 to reach its goal
     however large the budget; retries alone would promise it."""
     from planner.odds import STUCK_RATES
 
