@@ -32,8 +32,8 @@ training objects (:data:`STUCK_RATES`, :func:`fit_stuck_rates`). Stuck draws are
 Closed-loop execution then replans from the new state and sometimes rolls back, but often not within the budget.
 A step may carry its tip probability ``t`` per try; each try of it then loses the run with probability
 ``f * t``, ``f`` the share of tips a plan does not recover from (:data:`TIP_FATAL`, fitted with the stuck rates,
-:func:`fit_stuck_rates`). On the 400 first plans of the plan bench, these odds moved the Brier score from 0.141 to
-0.13 (docs/guide.md, "What a plan predicts").
+:func:`fit_odds`). On the plan bench's 400 tasks (``affordplan bench plan --tasks 50 --sim arm --objects mixed``,
+seeds 0-7; the same plans and outcomes as before) the Brier score of ``p_success`` went from 0.141 to 0.128.
 """
 
 from __future__ import annotations
