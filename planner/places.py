@@ -1,5 +1,5 @@
 """Where on the table the planner puts the object: the free part of a goal's region, a free yaw, the nearest free
-place, room to roll, and room to turn.
+place, and room to roll.
 
 Each search is a small grid or ring search over the footprint checkers of the object's resting states
 (:mod:`planner.motion`); what the planner has learned from failures (spots where rolls failed, pushes it avoids) is
@@ -29,13 +29,6 @@ GOAL_AIM_RING = 0.002
 GOAL_AIM_YAW_STEP = math.radians(2.5)
 FREE_YAW_STEPS = np.radians([0.0] + [sign * a for a in range(5, 180, 5) for sign in (1, -1)] + [180.0])
 FREE_SEARCH_SLACK = 0.02  # metres past the nearest free position that nearest_free looks for a better one
-TURN_SPOT_MOVE_COST = 0.05  # metres of path a turn spot other than the object's own place must save (turn_spot)
-# How far a spin is taken to shift an object, in multiples of its radius (Places.spin_room). Measured (arm sim,
-# shipped spin, 25-35 deg): 16 spins of the 10 cm cube shifted it 2.4-7.1 cm, median 6.4 cm, for a radius of
-# 7.1 cm; 10 of the mug 2.4-4.3 cm, median 3.2 cm, for a radius of 6.1 cm. A whole radius (the worst seen) cost
-# a large frustum its goal 0.65 m out on bench seed 0 (0.90 against 0.92); half of it and none scored alike
-# on seeds 0 and 1 (0.92, 0.84), and half still keeps the die's turns off its goal 0.68 m out.
-SPIN_DRIFT = 0.5
 
 
 def disc(radius: float, n: int) -> np.ndarray:
@@ -125,34 +118,6 @@ class Places:
             return goal
         return replace(goal, xy=(float(x), float(y)), yaw=None if free_yaw else float(wrap_angle(a)),
                        xy_tol=goal.xy_tol - r, yaw_tol=goal.yaw_tol - turn)
-
-    def spin_room(self, state: int, x: float, y: float) -> bool:
-        """Whether the object (in ``state``, centred at ``(x, y)``) may be spun there: its inflated footprint
-        stays within ``reach`` after a drift of ``SPIN_DRIFT`` times its own radius, so that it can still be
-        pushed back from every side. Always, without ``reach``."""
-        if self.reach is None:
-            return True
-        drift = SPIN_DRIFT * (self.radius[state] - self.clearance)
-        return math.hypot(x, y) + self.radius[state] + drift <= self.reach
-
-    def turn_spot(self, state: int, start, end) -> tuple[float, float] | None:
-        """Where to turn from ``start``'s yaw to ``end``'s when the path's own turn has no room to drift.
-
-        The start itself where it has room to spin (:meth:`spin_room`) and is free at both yaws and half-way;
-        else the place (1 cm grid over the workspace) that has, with the shortest way from the start through
-        it to the end, plus ``TURN_SPOT_MOVE_COST`` for moving at all: a spot a push short of the start would
-        be overshot (pushes move 5-9 cm) and pushed back to, over and over. ``None`` where there is none.
-        """
-        checker = self.checkers[state]
-        yaws = (start[2], end[2], start[2] + 0.5 * float(wrap_angle(end[2] - start[2])))
-
-        def room(px: float, py: float) -> bool:
-            return self.spin_room(state, px, py) and all(checker.is_free(px, py, a) for a in yaws)
-
-        if room(start[0], start[1]):
-            return float(start[0]), float(start[1])
-        return grid_argmin(self.workspace, lambda px, py: math.hypot(px - end[0], py - end[1])
-                            + math.hypot(px - start[0], py - start[1]) + TURN_SPOT_MOVE_COST, room)
 
     def free_yaw(self, state: int, xy, prefer: float) -> float:
         """The yaw nearest ``prefer`` (5 deg steps either way, all round) at which ``state`` is free at ``xy``.

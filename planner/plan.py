@@ -21,9 +21,8 @@ twice is not rolled at again (the object is pushed to the nearest other room fir
 fingertip would come down on an obstacle is split the same way from the start.
 
 The arm reaches so far (``reach``, from its base at the world origin): footprints stay where the fingertip
-can get all round them, and spins, which shift objects by centimetres (up to their own radius), happen where
-a shift of half that radius still leaves the object within reach (the turn is moved to such a spot when the
-path's own is not).
+can get all round them. (Until 0.24 spins were also moved to where half the object's radius of drift still left
+it within reach; on the plan bench's 400 tasks that bought nothing, docs/architecture.md.)
 """
 
 from __future__ import annotations
@@ -150,8 +149,8 @@ class Planner:
         seed: seeds OMPL and the predictor.
         clearance: metres the footprint is grown by (room for the fingertip beside the object).
         roll_margin: metres around a roll spot kept clear for the displacement a roll causes.
-        reach: metres from the arm's base (the world origin) that the inflated footprints stay within, and
-            within which spins are placed with room to drift (:meth:`Places.spin_room`); ``None``: no arm to reach.
+        reach: metres from the arm's base (the world origin) that the inflated footprints stay within; ``None``: no
+            arm to reach.
     """
 
     def __init__(self, obj: ObjectModel, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
@@ -371,9 +370,7 @@ class Planner:
         ``final_yaw`` at the end when given.
 
         Where the start is not free (the object was pushed into a tight spot, or a roll is expected to leave it
-        there), it is first pushed to the nearest free place (:meth:`Places.nearest_free`). Where the calls would
-        spin the object without room to drift (:meth:`Places.spin_room`), the turn is made at a spot that has it
-        (:meth:`Places.turn_spot`): push there at the start's yaw, turn, push on at the end's.
+        there), it is first pushed to the nearest free place (:meth:`Places.nearest_free`).
         """
         def calls_for(path: np.ndarray, yaw: float | None) -> list[chain.Call]:
             return chain.path_to_calls(path, yaw, is_free=self.checkers[state].is_free,
@@ -385,18 +382,7 @@ class Planner:
             out.append(("push", {"direction": math.atan2(free[1] - start[1], free[0] - start[0])}, (*free, start[2])))
             start = (*free, start[2])
         path = self._path(state, start, end, deadline)
-        calls = calls_for(path, final_yaw)
-        if all(self.places.spin_room(state, *after[:2]) for skill, _, after in calls if skill == "spin"):
-            return [path], out + calls
-        spot = self.places.turn_spot(state, start, end)
-        if spot is None:
-            return [path], out + calls
-        try:
-            to_spot = self._path(state, start, (*spot, start[2]), deadline)
-            from_spot = self._path(state, (*spot, end[2]), end, deadline)
-        except (PlanningError, GoalError):  # no way round by the spot in time: turn where the path does
-            return [path], out + calls
-        return [to_spot, from_spot], out + calls_for(to_spot, end[2]) + calls_for(from_spot, final_yaw)
+        return [path], out + calls_for(path, final_yaw)
 
     def _steps(self, state: int, start: tuple[float, float, float], calls) -> list[Step]:
         steps: list[Step] = []

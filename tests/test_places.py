@@ -25,12 +25,6 @@ def cube():
     return ap.load_object("cube")
 
 
-def test_spins_have_room_only_where_a_drift_stays_in_reach(cube):
-    places = places_for(cube)
-    assert places.spin_room(0, 0.5, 0.0) and not places.spin_room(0, 0.7, 0.0)
-    assert places_for(cube, reach=None).spin_room(0, 0.7, 0.0)
-
-
 def test_a_free_yaw_is_the_nearest_turn_that_fits(cube):
     places = places_for(cube, (BLOCK,))
     assert places.free_yaw(0, (0.5, 0.2), 0.3) == pytest.approx(0.3)  # open: as preferred

@@ -60,29 +60,6 @@ def test_path_through_the_gap_is_collision_free():
     assert goal.reached(cube, steps[-1].expected_pose)
 
 
-def test_turns_near_the_reach_edge_are_made_where_a_drift_can_still_be_pushed_back():
-    """A 10 cm cube 1 cm short of a goal at x = 0.68 m, turned 40 deg off it: spins shift objects by up to their
-    size, and one that drifted out there could no longer be pushed back; the turn is made further in."""
-    cube = ap.load_object("cube")
-    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
-    goal = ap.Goal(xy=(0.68, 0.0), yaw=math.radians(40.0), resting_state=0, yaw_symmetric=False)
-    T0 = cube.resting_states[0].pose((0.67, 0.0), 0.0)
-    planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
-    assert not planner.places.spin_room(0, 0.67, 0.0) and planner.places.spin_room(0, 0.6, 0.0)
-    plan = planner.plan(T0, goal)
-    spins = [s for s in plan.steps if s.skill == "spin"]
-    assert spins and all(planner.places.spin_room(0, s.start_pose[0, 3], s.start_pose[1, 3]) for s in spins)
-    assert all(planner.checkers[0].is_free(*cube.planar_pose(s.expected_pose)[1:]) for s in plan.steps)
-    sim = ap.Simulator(cube, seed=0)
-    sim.set_object_pose(plan.start_pose, settle=False)
-    ex = execute_plan(plan, sim=sim, max_primitives=20)
-    assert ex.success, str(ex)
-
-    unbounded = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0, reach=None)
-    spins = [s for s in unbounded.plan(T0, goal).steps if s.skill == "spin"]
-    assert spins and all(s.start_pose[0, 3] > 0.66 for s in spins)  # no arm to reach: turned where it is
-
-
 def test_a_push_with_no_room_for_the_fingertip_is_made_round():
     """A cube pressed against a block (1.5 cm clear) is pushed away from it by two pushes to either side, not
     by one whose fingertip would come down on the block."""
