@@ -61,14 +61,6 @@ class FailureMemory:
         """Whether this call failed :data:`FAILURES_TO_AVOID` times."""
         return self.count(skill, params, T_world_object) >= FAILURES_TO_AVOID
 
-    def spin_failed(self, state: int) -> bool:
-        """Whether spins in ``state`` failed :data:`FAILURES_TO_AVOID` times in either sense."""
-        return any(self.failures[(state, "spin", sense)] >= FAILURES_TO_AVOID for sense in (1, -1))
-
-    def roll_failed(self, state: int, target: int) -> bool:
-        """Whether rolls from ``state`` to ``target`` failed :data:`FAILURES_TO_AVOID` times (anywhere)."""
-        return self.failures[(state, "roll", target)] >= FAILURES_TO_AVOID
-
     def spoiled(self, x: float, y: float) -> bool:
         """Whether rolls failed :data:`ROLL_SPOT_FAILURES` times within :data:`ROLL_SPOT_RADIUS` of (x, y)."""
         near = sum(math.hypot(x - fx, y - fy) <= ROLL_SPOT_RADIUS for fx, fy in self.roll_spots)

@@ -62,14 +62,6 @@ SPLIT_ANGLE = math.radians(35.0)
 # Turns tried, in order, on each side of a push that failed twice (the first is SPLIT_ANGLE): each detour
 # push must itself not have failed twice, or the plan would repeat a failure under another name.
 DETOUR_ANGLES = (SPLIT_ANGLE,) + tuple(math.radians(a) for a in (60.0, 85.0))  # never backwards
-# A goal yaw is reached before the last roll, where spinning is likelier to succeed, when the success
-# model rates a 30 deg spin (planner.ratings.TURN_PROBE_ANGLE) there this much higher than in the goal's
-# resting state (a frustum on its side, say, cannot be spun; on its base it can).
-TURN_BEFORE_MARGIN = 0.15
-# Where the goal's resting state spins this badly (predicted, or spins there failed twice) and no roll into
-# it comes from a state that spins better, the plan rolls away to a neighbour that does, turns there, and
-# rolls back (when the two rolls and a spin there are likelier than a spin in the goal state).
-SPIN_DETOUR_BELOW = 0.3
 CLEARANCE = 0.02  # metres the footprints are grown by (room for the fingertip beside the object)
 WORKSPACE_OVERHANG = 0.05  # metres the footprint may reach past the workspace edge
 SAME_POSE = 1e-9  # metres or radians within which two path ends are the same (_path)
@@ -288,8 +280,6 @@ class Planner:
         goal_state, goal = self._checked_aim(goal, state)  # the free part of the goal's region
         turn = not goal.yaw_free(self.obj, goal_state)  # whether the goal's yaw asks for anything
         route = self.graph.route(state, goal_state)
-        if turn:
-            route = self._route_to_turn(route, yaw, goal)
         best, error = None, None
         for late_from in self._placements(route):
             try:
@@ -322,11 +312,7 @@ class Planner:
         cur = start
         for k, (a, b) in enumerate(zip(route, route[1:])):
             spot = self.places.roll_spot(a, b, cur, goal, late=k >= late_from, spoiled=self.memory.spoiled)
-            want_yaw = cur[2]
-            last_roll = k == len(route) - 2
-            if turn and last_roll and self._turns_better(a, goal_state):
-                want_yaw = self._yaw_before_roll(a, b, spot, goal, cur[2])  # turn here, arrive turned
-            spot_yaw = self.places.free_yaw(a, spot, want_yaw)
+            spot_yaw = self.places.free_yaw(a, spot, cur[2])
             segment_paths, segment = self._segment(a, cur, (*spot, spot_yaw), deadline)
             paths += [(a, path) for path in segment_paths]
             calls += [(a, *c) for c in segment]
@@ -407,52 +393,6 @@ class Planner:
             for s, p in zip(asked, ps):
                 s.p_success = float(p)
         return steps
-
-    def _spin_rating(self, state: int) -> float:
-        """:meth:`StateRatings.spin`, or 0 where a spin in ``state`` (either way) has failed twice."""
-        if self.memory.spin_failed(state):
-            return 0.0
-        return self.ratings.spin(state)
-
-    def _turns_better(self, before: int, goal_state: int) -> bool:
-        """Whether the object spins clearly better in state ``before`` than in the goal's resting state."""
-        return self._spin_rating(before) > self._spin_rating(goal_state) + TURN_BEFORE_MARGIN
-
-    def _route_to_turn(self, route: list[int], yaw: float, goal: Goal) -> list[int]:
-        """``route``, or ``route`` plus a roll away from the goal's state and back, to turn the object there.
-
-        The detour is taken when a turn is needed (the route rolls, or the start's yaw is off the goal's), the
-        goal's state spins badly (:data:`SPIN_DETOUR_BELOW`), the route's last roll does not come from a state
-        that spins better (:meth:`_turns_better`: the turn is made there), and for the best neighbour ``s``,
-        ``P(roll g->s) P(spin in s) P(roll s->g)`` beats ``P(spin in g)``; a neighbour whose roll from ``g``
-        failed twice is not tried again (:meth:`FailureMemory.roll_failed`).
-        """
-        g = route[-1]
-        if len(route) == 1 and goal.yaw_error(self.obj, g, yaw) <= goal.yaw_tol:
-            return route
-        if self._spin_rating(g) >= SPIN_DETOUR_BELOW or (len(route) > 1 and self._turns_better(route[-2], g)):
-            return route
-        best, best_p = None, self._spin_rating(g)
-        for s in self.graph.graph.successors(g):
-            if s == g or not self.graph.graph.has_edge(s, g) or not self._turns_better(s, g):
-                continue
-            if self.memory.roll_failed(g, s):  # a spin rated 0 (failed twice) would otherwise keep any detour
-                continue
-            p = self.graph.probability(g, s) * self._spin_rating(s) * self.graph.probability(s, g)
-            if p > best_p:
-                best, best_p = int(s), p
-        return route if best is None else route + [best, g]
-
-    def _yaw_before_roll(self, a: int, b: int, spot, goal: Goal, yaw: float) -> float:
-        """Yaw in state ``a`` at ``spot`` from which the roll to ``b`` ends at the goal's yaw (ideally); of the
-        yaws the goal takes as equal (:meth:`Goal.yaw_near`), the one the least turn from ``yaw`` reaches.
-
-        Rolls are equivariant under turns about the vertical: turning the object by ``d`` before the roll
-        turns the rolled pose by ``d``. So one expected roll from yaw 0 gives the offset.
-        """
-        T_after = expected_pose(self.obj, "roll", {"target": b}, state_pose(self.obj, a, *spot, 0.0))
-        offset = self.obj.planar_pose(T_after)[3]
-        return float(wrap_angle(goal.yaw_near(self.obj, b, yaw + offset) - offset))
 
     def _detour(self, direction: float, T: np.ndarray) -> list[float]:
         """Pushes that stand in for a push along ``direction`` (radians) from pose ``T`` that is avoided: it

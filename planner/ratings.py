@@ -8,7 +8,6 @@ frame), and each is one batched query, asked once per state (or edge) and kept: 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -16,7 +15,6 @@ import numpy as np
 from affordplan.objects.model import ObjectModel
 from planner.predict import Predictor, state_pose
 
-TURN_PROBE_ANGLE = math.radians(30.0)  # the spin, either way, that rates how well a state spins (StateRatings.spin)
 SPIN_RATE_GRID = np.radians([15.0, 25.0, 35.0, 45.0])  # spin angles rated per state to split turns (spin_rate)
 
 
@@ -34,7 +32,6 @@ class StateRatings:
         self.obj = obj
         self.predictor = predictor
         self.at = (float(at[0]), float(at[1]))
-        self._spin: dict[int, float] = {}  # resting state -> mean P(spin by TURN_PROBE_ANGLE, either way)
         self._spin_rows: dict[tuple[int, int], np.ndarray] = {}  # (state, sense) -> P(spin) over SPIN_RATE_GRID
 
     def _pose(self, state: int) -> np.ndarray:
@@ -44,14 +41,6 @@ class StateRatings:
         """P(roll i -> j) for each edge ``(i, j)`` (one batched query; :class:`planner.graph.RestingStateGraph`
         asks it once for all its edges)."""
         return self.predictor.p_success_many([("roll", {"target": j}, self._pose(i)) for i, j in edges])
-
-    def spin(self, state: int) -> float:
-        """Predicted success of a spin by :data:`TURN_PROBE_ANGLE` in ``state``, the mean of both ways."""
-        if state not in self._spin:
-            turns = [{"angle": a} for a in (TURN_PROBE_ANGLE, -TURN_PROBE_ANGLE)]
-            T = self._pose(state)
-            self._spin[state] = float(np.mean(self.predictor.p_success_many([("spin", t, T) for t in turns])))
-        return self._spin[state]
 
     def spin_rate(self, state: int) -> Callable[[float], float]:
         """``rate(angle)``: predicted success of a spin by ``angle`` (radians, signed, 15-45 deg) in ``state``,

@@ -30,7 +30,7 @@ def test_a_call_is_avoided_after_failing_twice_and_a_copy_records_apart():
     copy = memory.copy()
     copy.record("spin", {"angle": 0.5}, T)
     copy.record("spin", {"angle": 0.4}, T)
-    assert copy.spin_failed(0) and not memory.spin_failed(0)
+    assert copy.count("spin", {"angle": 0.5}, T) == 2 and memory.count("spin", {"angle": 0.5}, T) == 0
 
 
 def test_a_place_where_rolls_failed_twice_is_spoiled():
@@ -41,14 +41,3 @@ def test_a_place_where_rolls_failed_twice_is_spoiled():
     memory.record("roll", {"target": 2}, cube.resting_states[0].pose((0.52, 0.0), 0.0))
     assert memory.spoiled(0.51, 0.0)
     assert not memory.spoiled(0.5 + 2.5 * ROLL_SPOT_RADIUS, 0.0)
-
-
-def test_a_roll_that_failed_twice_anywhere_has_failed():
-    """``roll_failed`` counts a (state, target), wherever the rolls were tried; spoiled spots count places."""
-    cube = ap.load_object("cube")
-    memory = FailureMemory(cube)
-    memory.record("roll", {"target": 1}, cube.resting_states[0].pose((0.5, 0.0), 0.0))
-    memory.record("roll", {"target": 2}, cube.resting_states[0].pose((0.52, 0.0), 0.0))
-    assert not memory.roll_failed(0, 1)
-    memory.record("roll", {"target": 1}, cube.resting_states[0].pose((0.2, 0.3), 0.0))
-    assert memory.roll_failed(0, 1) and not memory.roll_failed(0, 2)

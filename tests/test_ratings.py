@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import affordplan as ap
-from planner.ratings import SPIN_RATE_GRID, TURN_PROBE_ANGLE, StateRatings
+from planner.ratings import SPIN_RATE_GRID, StateRatings
 
 
 class CountingPredictor:
@@ -32,17 +32,6 @@ class CountingPredictor:
 @pytest.fixture
 def ratings():
     return StateRatings(ap.load_object("cube"), CountingPredictor(), (0.5, -0.1))
-
-
-def test_a_states_spin_is_asked_once_both_ways_where_told(ratings):
-    p = ratings.spin(0)
-    assert p == pytest.approx(0.5 * (0.6 + 0.3))  # 30 deg: 0.6 anticlockwise, half that clockwise
-    assert ratings.spin(0) == p and len(ratings.predictor.asked) == 1
-    (query,) = ratings.predictor.asked
-    assert sorted(q[1]["angle"] for q in query) == pytest.approx([-TURN_PROBE_ANGLE, TURN_PROBE_ANGLE])
-    T = query[0][2]
-    assert T[:2, 3] == pytest.approx((0.5, -0.1))
-    assert ratings.obj.classify(T) == 0
 
 
 def test_spin_rates_interpolate_one_row_per_sense(ratings):
