@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from affordplan.checks import as_whole
+from affordplan.checks import as_finite, as_whole
 from affordplan.errors import InputError
 
 if TYPE_CHECKING:
@@ -62,7 +62,7 @@ Q_FLOOR = 0.02  # a step rated below this is treated as this: the executor repla
 # S = 100-103.)
 STUCK_RATES: dict[str, float] = {"push": 0.0, "roll": 0.6, "spin": 0.2}
 # The share of tips (a push or spin that leaves the object in another resting state) after which a run does not
-# reach the goal; fitted with STUCK_RATES (fit_stuck_rates), the record beside them.
+# reach the goal; fitted with STUCK_RATES (fit_odds), the record beside them.
 TIP_FATAL = 0.2
 
 
@@ -137,7 +137,7 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
     budget = as_whole("budget", budget, 0, 100_000)
     n = as_whole("n", n, 1, 10_000_000)
     rates = _stuck_rates(stuck_rate)
-    fatal = _probability("tip_fatal", TIP_FATAL if tip_fatal is None else tip_fatal)
+    fatal = as_finite("tip_fatal", TIP_FATAL if tip_fatal is None else tip_fatal, 0.0, 1.0)
     skills, q, tips = [], [], []
     for step in steps:
         try:
@@ -182,13 +182,14 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
         free[:, :m] = rng.random((n, m)) >= stuck
     # per step: the probability that a try loses the run (a tip not recovered from); step m (done) never does
     lose = np.append(fatal * np.asarray(tips), 0.0)
+    can_tip = bool(np.any(lose > 0.0))  # tips are drawn only then, so plans that cannot tip keep their odds exactly
     alive = np.ones(n, dtype=bool)
     runs = np.arange(n)
     step = np.zeros(n, dtype=np.int64)  # each run's current step (m: done)
     acc = np.zeros(n)  # progress accumulated in the run's current stretch
     spent = np.full(n, budget, dtype=np.int64)
     for t in range(1, budget + 1):
-        if np.any(lose > 0.0):  # drawn only for plans that can tip, so plans that cannot keep their odds exactly
+        if can_tip:
             alive &= rng.random(n) >= lose[step]
         acc += pool[step, rng.integers(n, size=n)] * (free[runs, step] & alive)
         covered = start[step] + np.floor(acc + 1e-9).astype(np.int64)
@@ -202,13 +203,6 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
     done = step == m
     # a run that finished on the budget's last primitive has spent == budget either way
     return Odds(p_success=float(done.mean()), expected_primitives=float(spent.mean()), budget=int(budget))
-
-
-def _probability(name: str, value: float) -> float:
-    """``value`` as a probability, or :class:`InputError` naming ``name``."""
-    if not (isinstance(value, (int, float, np.floating)) and np.isfinite(value) and 0.0 <= value <= 1.0):
-        raise InputError(f"{name} must lie in [0, 1], got {value!r}")
-    return float(value)
 
 
 def _stuck_rates(stuck_rate: float | Mapping[str, float] | None) -> dict[str, float]:
@@ -273,14 +267,14 @@ def fit_odds(plans: Sequence[Sequence[tuple]], reached: Sequence[bool], models: 
     Raises:
         InputError: as :func:`fit_stuck_rates`.
     """
-    best = None
+    best, without = None, None
     for fatal in np.asarray(fatal_grid, dtype=float):
-        rates, score, _ = fit_stuck_rates(plans, reached, models, budget, grid, seed, n, tip_fatal=float(fatal))
+        rates, score, bare = fit_stuck_rates(plans, reached, models, budget, grid, seed, n, tip_fatal=float(fatal))
+        if fatal == 0.0:
+            without = bare  # the score with neither stuck steps nor tips
         if best is None or score < best[2] - 1e-12:
             best = (rates, float(fatal), score)
-    y = np.asarray(reached, dtype=float)
-    bare = np.array([mc_odds(steps, models, budget, seed=seed, n=n, stuck_rate=0.0, tip_fatal=0.0).p_success
-                     for steps in plans])
-    without = float(np.mean((bare - y) ** 2))
+    if without is None:  # a grid without 0: simulate the bare odds once more
+        without = fit_stuck_rates(plans, reached, models, budget, grid, seed, n, tip_fatal=0.0)[2]
     rates, fatal, score = best
     return rates, fatal, score, without

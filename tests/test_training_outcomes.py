@@ -41,6 +41,12 @@ def test_annotate_refuses_a_file_it_cannot_read_on_the_command_line(tmp_path, ca
     np.savez(path, p=np.zeros(2))
     with pytest.raises(InputError, match="object"):
         annotate(str(path), progress=False)
+    np.savez(path, objects=np.asarray(["cube"]), object=np.zeros(1, np.int16), state_before=np.zeros(1, np.int16))
+    with pytest.raises(InputError, match="state_after"):
+        annotate(str(path), progress=False)
+    path.write_bytes(b"not an npz file")
+    with pytest.raises(InputError, match="not a readable outcome file"):
+        annotate(str(path), progress=False)
     assert main(["annotate", str(tmp_path / "missing.npz")]) == 2
     assert "no outcome file" in capsys.readouterr().err
 

@@ -95,6 +95,7 @@ import shlex
 import sys
 import time
 import warnings
+import zipfile
 from collections import OrderedDict
 from collections.abc import Mapping
 from pathlib import Path
@@ -170,9 +171,12 @@ def annotate(path: str, progress: bool = True) -> dict:
     src = Path(path)
     if not src.is_file():
         raise InputError(f"no outcome file at {str(path)!r}")
-    with np.load(src, allow_pickle=False) as f:
-        data = {k: np.array(f[k]) for k in f.files}
-    missing = [c for c in ("objects", "object", "state_before") if c not in data]
+    try:
+        with np.load(src, allow_pickle=False) as f:
+            data = {k: np.array(f[k]) for k in f.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+        raise InputError(f"{path} is not a readable outcome file ({type(exc).__name__}: {exc})") from exc
+    missing = [c for c in ("objects", "object", "state_before", "state_after") if c not in data]
     if missing:
         raise InputError(f"{path} cannot be annotated: it has no {', '.join(missing)}")
     names = [str(n) for n in data["objects"]]
