@@ -15,7 +15,7 @@ from affordplan.objects.model import ObjectModel
 from affordplan.world import Box, Workspace, as_box
 from planner.footprint import footprint
 from planner.motion import FootprintChecker
-from planner.plan import WORKSPACE_OVERHANG, Plan, Planner
+from planner.plan import MAX_STRIDES, WORKSPACE_OVERHANG, Plan, Planner
 from planner.predict import Predictor
 
 PlannerName = Literal["affordplan", "greedy"]
@@ -82,7 +82,7 @@ def check_start(obj: ObjectModel, T_start: np.ndarray, obstacles: Sequence[Box],
 def plan(obj: ObjectModel, goal: Goal, *, start: StartLike = None,
          obstacles: Iterable[Box | Mapping[str, Any]] = (), time_limit: float = 5.0,
          planner: PlannerName = "affordplan", seed: int = 0, predictor: Predictor | None = None,
-         workspace: Workspace = Workspace()) -> Plan:
+         workspace: Workspace = Workspace(), max_strides: int = MAX_STRIDES) -> Plan:
     """Plan to bring ``obj`` from ``start`` to ``goal`` among ``obstacles`` (see :class:`planner.plan.Planner`).
 
     ``start``: a :class:`affordplan.goal.Start` dict ``{"resting_state": i, "xy": (x, y), "yaw": rad}`` (each key
@@ -91,6 +91,9 @@ def plan(obj: ObjectModel, goal: Goal, *, start: StartLike = None,
 
     ``planner="greedy"`` returns the reactive baseline: a plan without steps whose ``execute`` picks
     every call on the spot (:func:`planner.execute.execute_greedy`).
+
+    ``max_strides``: the 5 cm strides one push call may make, correcting its course between strokes
+    (:func:`planner.plan.merge_strides`); 1 makes every push one stroke, as until 0.24.
 
     Raises:
         GoalError: the goal is malformed, in an obstacle, off the workspace or in a resting state the
@@ -115,7 +118,7 @@ def plan(obj: ObjectModel, goal: Goal, *, start: StartLike = None,
                          f"{describe(obstacles)}")
     T0 = start_pose(obj, start)
     boxes = tuple(as_box(b, f"obstacles[{i}]") for i, b in enumerate(obstacles))
-    p = Planner(obj, boxes, workspace, predictor=predictor, time_limit=time_limit, seed=seed)
+    p = Planner(obj, boxes, workspace, predictor=predictor, time_limit=time_limit, seed=seed, max_strides=max_strides)
     check_start(obj, T0, boxes, workspace)
     if planner == "greedy":
         p.check_goal(goal, obj.classify(T0))

@@ -3,7 +3,8 @@
 :func:`execute_plan` runs a :class:`planner.plan.Plan` in a simulator: observe the object's pose; if
 the goal is reached, stop; if the pose is off the plan (more than ``XY_TOL`` / ``YAW_TOL`` from where
 the next step expects it, or in another resting state), replan from the observed pose; execute the
-next step's skill with its parameter; remember failures (calls that did not move the object the way
+next step's skill with its parameter (a push of several strides is one call that corrects its course between
+strokes, :func:`primitives.strokes.push_to`); remember failures (calls that did not move the object the way
 they asked: :func:`made_progress`), so that a (state, skill, parameter) that failed twice is avoided
 by the next plan. It stops on success, on ``max_primitives``, or when no plan
 can be found.
@@ -33,6 +34,7 @@ from planner.predict import expected_pose
 from primitives import params as skill_params
 from primitives.params import made_progress
 from primitives.skills import Skill, skills_sensor
+from primitives.strokes import push_to
 
 if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its plans
     from planner.plan import Planner
@@ -56,6 +58,7 @@ class LogEntry:
     p_success: float = float("nan")
     note: str = ""
     states: tuple[int, int] | None = None  # resting states before and after
+    strokes: int = 1  # fingertip strokes the call made (a push of several strides: primitives.strokes)
 
     def __str__(self) -> str:
         (k, v), = self.params.items()
@@ -65,6 +68,7 @@ class LogEntry:
         if self.states:
             a, b = self.states
             where = f"state {a} " if a == b else f"state {a} -> {b} "
+        value += f" {self.strokes} strokes" if self.strokes > 1 else ""
         return (f"{self.index:2d}. {self.skill:4s} {k}={value:10s} ({x0:.3f}, {y0:.3f}) -> ({x1:.3f}, {y1:.3f}) "
                 f"{where}{'ok ' if self.success else 'FAIL'}{' (replanned)' if self.replanned else ''}"
                 f"{' ' + self.note if self.note else ''}")
@@ -77,7 +81,8 @@ class Execution:
     Attributes:
         success: the goal was reached (position, yaw, resting state within the goal's tolerances).
         final_pose: the object's last 4x4 world pose.
-        n_primitives: skill calls executed.
+        n_primitives: skill calls executed (a push of several strides is one call; :attr:`strokes` counts its
+            strokes).
         replans: plans made after the first (the object went off plan or a step failed).
         log: one entry per primitive.
         reason: why it stopped.
@@ -97,9 +102,14 @@ class Execution:
     errors: tuple[float, float, bool] | None = None
     plan_times: list[float] = field(default_factory=list)  # seconds of the first plan and of each replan
 
+    @property
+    def strokes(self) -> int:
+        """Fingertip strokes over all calls (a call is one stroke, but a push of several strides may make more)."""
+        return sum(e.strokes for e in self.log)
+
     def __str__(self) -> str:
-        head = (f"execution: {'SUCCESS' if self.success else 'FAILED'} after {self.n_primitives} primitives, "
-                f"{self.replans} replans ({self.reason})")
+        head = (f"execution: {'SUCCESS' if self.success else 'FAILED'} after {self.n_primitives} primitives "
+                f"({self.strokes} strokes), {self.replans} replans ({self.reason})")
         if self.errors is not None:
             d, yaw, state_ok = self.errors
             head += (f"; final error {100 * d:.1f} cm, {math.degrees(yaw):.0f} deg, resting state "
@@ -219,8 +229,13 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
                 break
         step = steps[k]
         skill = skills[step.skill]
+        strokes = 1
         try:
-            out = skill.execute(sim, step.params)
+            if step.skill == "push" and step.strides > 1:
+                made = push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides, step.params["direction"])
+                out, strokes = made.outcome, made.strokes
+            else:
+                out = skill.execute(sim, step.params)
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
             planner.record_failure(step.skill, step.params, T)
             log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc),
@@ -231,7 +246,8 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
             planner.record_failure(step.skill, step.params, T)
         log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
                             out.pose_after, replanned, step.p_success, states=_states(obj, out.pose_before,
-                                                                                      out.pose_after)))
+                                                                                      out.pose_after),
+                            strokes=strokes))
         _record_frame(sim, render, frames)
         if (stop := _terminal(out)) is not None:
             reason = stop

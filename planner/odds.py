@@ -46,6 +46,7 @@ import numpy as np
 
 from affordplan.checks import as_finite, as_whole
 from affordplan.errors import InputError
+from primitives.strokes import EXTRA_STROKES
 
 if TYPE_CHECKING:
     from primitives.outcome_model import OutcomeModel
@@ -138,23 +139,10 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
     n = as_whole("n", n, 1, 10_000_000)
     rates = _stuck_rates(stuck_rate)
     fatal = as_finite("tip_fatal", TIP_FATAL if tip_fatal is None else tip_fatal, 0.0, 1.0)
-    skills, q, tips = [], [], []
-    for step in steps:
-        try:
-            skill, p, *rest = step
-            p, tip = float(p), float(rest[0]) if rest else 0.0
-            if len(rest) > 1:
-                raise ValueError
-        except (TypeError, ValueError):
-            raise InputError(f"a step must be (skill, strict p) or (skill, strict p, tip), got {step!r:.60}") from None
-        for name, value in (("step probabilities", p), ("tip probabilities", tip)):
-            if not (np.isfinite(value) and 0.0 <= value <= 1.0):
-                raise InputError(f"{name} must lie in [0, 1], got {value!r} for {skill!r}")
+    skills, q, tips, group, strokes = _expand(steps)
+    for skill in skills:
         if skill not in models:
             raise InputError(f"no outcome model for {skill!r} (models for {sorted(models)})")
-        skills.append(skill)
-        q.append(p)
-        tips.append(tip)
     m = len(skills)
     if m == 0:
         return Odds(p_success=1.0, expected_primitives=0.0, budget=int(budget))
@@ -188,14 +176,23 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
     step = np.zeros(n, dtype=np.int64)  # each run's current step (m: done)
     acc = np.zeros(n)  # progress accumulated in the run's current stretch
     spent = np.full(n, budget, dtype=np.int64)
+    group = np.append(group, -1)  # step m (done) is in no call
     for t in range(1, budget + 1):
-        if can_tip:
-            alive &= rng.random(n) >= lose[step]
-        acc += pool[step, rng.integers(n, size=n)] * (free[runs, step] & alive)
-        covered = start[step] + np.floor(acc + 1e-9).astype(np.int64)
-        finished = covered >= end[step]
-        step = np.where(finished, end[step], np.minimum(covered, end[step]))
-        acc[finished] = 0.0
+        call = group[step]  # the call each run makes with this primitive
+        for stroke in range(int(strokes.max())):
+            if stroke == 0:
+                active = np.ones(n, dtype=bool)
+            else:  # further strokes: runs still in their call's steps and within its strokes
+                active = (group[step] == call) & (call >= 0) & (stroke < strokes[np.maximum(call, 0)])
+                if not active.any():
+                    break
+            if can_tip:
+                alive &= ~active | (rng.random(n) >= lose[step])
+            acc += pool[step, rng.integers(n, size=n)] * (free[runs, step] & alive & active)
+            covered = start[step] + np.floor(acc + 1e-9).astype(np.int64)
+            finished = covered >= end[step]
+            step = np.where(finished, end[step], np.minimum(covered, end[step]))
+            acc[finished] = 0.0
         newly = (step == m) & (spent == budget)
         spent[newly] = t
         if np.all(step == m):
@@ -203,6 +200,35 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
     done = step == m
     # a run that finished on the budget's last primitive has spent == budget either way
     return Odds(p_success=float(done.mean()), expected_primitives=float(spent.mean()), budget=int(budget))
+
+
+def _expand(steps: Sequence[tuple]) -> tuple[list[str], list[float], list[float], np.ndarray, np.ndarray]:
+    """``steps`` (:func:`mc_odds`) checked and spread into unit steps: per unit its skill, strict p, tip and call
+    (index into the returned strokes per call); a step of ``strides`` k > 1 becomes k units of one call of at most
+    k + 1 strokes (:data:`primitives.strokes.EXTRA_STROKES`), any other step one unit of a one-stroke call."""
+    skills: list[str] = []
+    q: list[float] = []
+    tips: list[float] = []
+    group: list[int] = []
+    strokes: list[int] = []
+    for step in steps:
+        try:
+            skill, p, *rest = step
+            p, tip = float(p), float(rest[0]) if rest else 0.0
+            k = as_whole("strides", rest[1], 1, 1000) if len(rest) > 1 else 1
+            if len(rest) > 2:
+                raise ValueError
+        except (TypeError, ValueError):
+            raise InputError(f"a step must be (skill, strict p[, tip[, strides]]), got {step!r:.60}") from None
+        for name, value in (("step probabilities", p), ("tip probabilities", tip)):
+            if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+                raise InputError(f"{name} must lie in [0, 1], got {value!r} for {skill!r}")
+        skills += [skill] * k
+        q += [p] * k
+        tips += [tip] * k
+        group += [len(strokes)] * k
+        strokes.append(k + EXTRA_STROKES if k > 1 else 1)
+    return skills, q, tips, np.array(group, dtype=np.int64), np.array(strokes or [1], dtype=np.int64)
 
 
 def _stuck_rates(stuck_rate: float | Mapping[str, float] | None) -> dict[str, float]:
@@ -240,7 +266,8 @@ def fit_stuck_rates(plans: Sequence[Sequence[tuple]], reached: Sequence[bool], m
     used = sorted({step[0] for steps in plans for step in steps})
     grid = np.asarray(grid, dtype=float)
     # misses[i][j]: every (1 - q) of plan j's steps of skill used[i]
-    misses = [[np.array([1.0 - step[1] for step in steps if step[0] == skill]) for steps in plans] for skill in used]
+    units = [_expand(steps)[:2] for steps in plans]  # a step of several strides is stuck per stride, as in mc_odds
+    misses = [[np.array([1.0 - p for s, p in zip(*u) if s == skill]) for u in units] for skill in used]
     # factors[i][g, j]: plan j's stuck factor from skill used[i]'s steps at rate grid[g], prod of 1 - r * (1 - q)
     factors = [np.array([[np.prod(1.0 - r * miss) for miss in skill_misses] for r in grid])
                for skill_misses in misses]

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from affordplan.checks import as_whole
 from affordplan.errors import GoalError, PlanningError
 from affordplan.geometry import wrap_angle
 from affordplan.goal import Goal
@@ -74,6 +75,11 @@ ARM_REACH = FINGERTIP_REACH - 0.025  # 0.79 m
 # Radius (metres) of the disc kept clear of obstacles where the fingertip comes down behind an object to push
 # it (Planner.push_blocked): the tip's, plus a margin.
 FINGER_ROOM = TIP_RADIUS + 0.006
+# A straight run of pushes is made as pushes of up to MAX_STRIDES 5 cm strides each, one call apiece that corrects
+# its course between strokes (merge_strides, primitives.strokes); pushes whose directions differ by no more than
+# MERGE_ANGLE count as one run.
+MAX_STRIDES = 4
+MERGE_ANGLE = math.radians(3.0)
 
 
 @dataclass
@@ -85,7 +91,10 @@ class Step:
         params: its parameter as a dict, ``{"direction": rad}`` ... (see :mod:`primitives.params`); given as a typed
             value (:class:`~primitives.params.PushParams` ...), its dict is kept; :attr:`typed_params` reads it typed.
         start_pose, expected_pose: 4x4 world poses before and (ideally) after.
-        p_success: the skill's predicted success at ``start_pose``.
+        p_success: the skill's predicted success at ``start_pose`` (of one stroke, for a push of several strides).
+        strides: a push's 5 cm strides (``PUSH_STEP``) along its direction, made as one call that corrects its
+            course between strokes (:func:`primitives.strokes.push_to`, to ``expected_pose``); 1 for every other
+            call, and for a push of one stride, which is one stroke.
     """
 
     skill: SkillName
@@ -93,14 +102,16 @@ class Step:
     start_pose: np.ndarray = field(repr=False)
     expected_pose: np.ndarray = field(repr=False)
     p_success: float = float("nan")
+    strides: int = 1
 
     def __init__(self, skill: SkillName, params: SkillParams | Mapping[str, float], start_pose: np.ndarray,
-                 expected_pose: np.ndarray, p_success: float = float("nan")) -> None:
+                 expected_pose: np.ndarray, p_success: float = float("nan"), strides: int = 1) -> None:
         self.skill = skill
         self.params = as_params(skill, params)
         self.start_pose = start_pose
         self.expected_pose = expected_pose
         self.p_success = p_success
+        self.strides = int(strides)
 
     @property
     def typed_params(self) -> SkillParams:
@@ -111,7 +122,29 @@ class Step:
         (k, v), = self.params.items()
         value = f"{math.degrees(v):+.0f} deg" if k in ("direction", "angle") else f"state {v}"
         x, y = self.expected_pose[0, 3], self.expected_pose[1, 3]
-        return f"{self.skill:4s} {k}={value:10s} -> ({x:.3f}, {y:.3f})  P={self.p_success:.2f}"
+        times = f" x{self.strides}" if self.strides > 1 else ""
+        return f"{self.skill:4s} {k}={value:10s}{times} -> ({x:.3f}, {y:.3f})  P={self.p_success:.2f}"
+
+
+def merge_strides(steps: Sequence[Step], max_strides: int) -> list[Step]:
+    """``steps`` with each run of consecutive pushes along one direction (within ``MERGE_ANGLE`` of the run's
+    first) made into pushes of up to ``max_strides`` strides: one call each, executed with course corrections
+    between its strokes (:func:`primitives.strokes.push_to`). A merged push starts where its run starts, is
+    expected where it ends, heads from the one to the other, and is rated by the mean of its strides' ratings (one
+    stroke's). ``max_strides`` 1 leaves the steps as they are."""
+    out: list[Step] = []
+    for s in steps:
+        last = out[-1] if out else None
+        if (last is not None and s.skill == "push" and last.skill == "push" and last.strides < max_strides
+                and abs(float(wrap_angle(s.params["direction"] - last.params["direction"]))) <= MERGE_ANGLE):
+            dx, dy = s.expected_pose[:2, 3] - last.start_pose[:2, 3]
+            n = last.strides + s.strides
+            p = (last.p_success * last.strides + s.p_success * s.strides) / n
+            heading = math.atan2(dy, dx) if math.hypot(dx, dy) > 1e-9 else last.params["direction"]
+            out[-1] = Step("push", {"direction": heading}, last.start_pose, s.expected_pose, p, n)
+        else:
+            out.append(s)
+    return out
 
 
 def inflated_footprints(obj: ObjectModel, clearance: float) -> dict[int, np.ndarray]:
@@ -140,6 +173,7 @@ class Planner:
         time_limit: seconds for one :meth:`plan` call (OMPL gets what is left).
         seed: seeds OMPL and the predictor.
         clearance: metres the footprint is grown by (room for the fingertip beside the object).
+        max_strides: strides of 5 cm one push call may make (:func:`merge_strides`); 1: every push one stroke.
         roll_margin: metres around a roll spot kept clear for the displacement a roll causes.
         reach: metres from the arm's base (the world origin) that the inflated footprints stay within; ``None``: no
             arm to reach.
@@ -147,7 +181,8 @@ class Planner:
 
     def __init__(self, obj: ObjectModel, obstacles: Sequence[Box] = (), workspace: Workspace = Workspace(),
                  predictor: Predictor | None = None, time_limit: float = 5.0, seed: int = 0,
-                 clearance: float = CLEARANCE, roll_margin: float = 0.04, reach: float | None = ARM_REACH):
+                 clearance: float = CLEARANCE, roll_margin: float = 0.04, reach: float | None = ARM_REACH,
+                 max_strides: int = MAX_STRIDES):
         self.obj = obj
         self.obstacles = tuple(obstacles)
         self.workspace = workspace
@@ -158,6 +193,7 @@ class Planner:
         self.roll_margin = roll_margin
         self.memory = FailureMemory(obj)  # failed calls and roll spots (planner.memory)
         self.reach = reach
+        self.max_strides = as_whole("max_strides", max_strides, 1, 100)
         self.footprints = inflated_footprints(obj, clearance)
         self._shadows = {s.index: footprint(obj, s.index) for s in obj.resting_states}  # not inflated
         self._finger = FootprintChecker(disc(FINGER_ROOM, 8), self.obstacles, Workspace((-2.0, 2.0), (-2.0, 2.0)))
@@ -191,18 +227,18 @@ class Planner:
             return mc_odds(self.odds_steps(steps), outcomes, budget, seed=self.seed)
         return plan_odds([s.p_success for s in steps], budget)
 
-    def odds_steps(self, steps: Sequence[Step]) -> list[tuple[str, float, float]]:
+    def odds_steps(self, steps: Sequence[Step]) -> list[tuple]:
         """Each step as :func:`planner.odds.mc_odds` reads it: ``(skill, strict p, tip)``, ``tip`` the probability
         that one try leaves the object in another resting state, from the skill's outcome model and the drop
         probability of the state the step starts in (:meth:`primitives.outcome_model.OutcomeModel.p_tip`; 0 without
-        outcome models)."""
+        outcome models); a push of several strides as ``(skill, strict p, tip, strides)``."""
         outcomes = getattr(self.predictor, "outcomes", None) or {}
         out = []
         for s in steps:
             model, tip = outcomes.get(s.skill), 0.0
             if model is not None and getattr(model, "knows_tips", False):
                 tip = model.p_tip(self.obj.resting_states[self.obj.classify(s.start_pose)].probability)
-            out.append((s.skill, float(s.p_success), float(tip)))
+            out.append((s.skill, float(s.p_success), float(tip)) + ((s.strides,) if s.strides > 1 else ()))
         return out
 
     # ------------------------------------------------------------------ queries
@@ -296,6 +332,7 @@ class Planner:
         if best is None:
             raise error
         _, steps, p, paths = best
+        steps = merge_strides(steps, self.max_strides)
         self._calls += 1
         odds = self.odds(steps, self.budget)
         return Plan(steps=steps, p_success=odds.p_success, planning_time=time.perf_counter() - t0, route=route,
@@ -517,7 +554,6 @@ class Plan:
         the plan's object and obstacles; ``render``: a truthy value records a frame per primitive in
         ``Execution.frames``, a string names the camera (default ``"overview"``); ``seed`` seeds a new simulator.
         """
-        from affordplan.checks import as_whole
         from planner.execute import execute_greedy, execute_plan
 
         max_primitives = as_whole("max_primitives", max_primitives, 1, 10_000)

@@ -320,8 +320,9 @@ def test_a_plans_odds_count_the_risk_that_pushes_in_a_rare_state_tip_the_object(
         plan = planner.plan(state_pose(mug, state, 0.40, 0.0, 0.0), ap.Goal(xy=(0.62, 0.05), resting_state=state))
         steps = planner.odds_steps(plan.steps)
         assert [s[:2] for s in steps] == [(s.skill, s.p_success) for s in plan.steps]
-        tips[state] = max(t for skill, _, t in steps if skill == "push")
-        bare = mc_odds([s[:2] for s in steps], planner.predictor.outcomes, planner.budget, seed=planner.seed)
+        tips[state] = max(s[2] for s in steps if s[0] == "push")
+        bare = mc_odds([(s[0], s[1], 0.0, *s[3:]) for s in steps], planner.predictor.outcomes, planner.budget,
+                       seed=planner.seed)
         if state == 2:
             assert plan.p_success < bare.p_success
         else:

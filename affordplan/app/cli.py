@@ -144,12 +144,13 @@ def _cmd_bench_query(args: argparse.Namespace) -> int:
 
 def _cmd_bench_plan(args: argparse.Namespace) -> int:
     from affordplan.app.bench.plan import bench_plan
+    from planner.plan import MAX_STRIDES
 
     log = (lambda text: print(text, file=sys.stderr, flush=True)) if args.log else None
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
                         max_primitives=args.max_primitives, progress=not args.json and not args.log,
                         only=args.task, log=log, weights_dir=args.weights_dir, draw=args.draw,
-                        objects=args.objects)
+                        objects=args.objects, max_strides=args.max_strides or MAX_STRIDES)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -510,6 +511,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="the tasks' objects: the procedural test split, HACMan's 25 unseen household meshes, or "
                          "the two by turns; training: the training objects by turns, for fitting the planner's "
                          "stuck rates, never for reporting (default: %(default)s)")
+    bp.add_argument("--max-strides", type=_positive_int, default=None, metavar="K",
+                    help="5 cm strides one push call may make, correcting its course between strokes; 1: one "
+                         "stroke per push, as until 0.24 (default: the planner's, planner.plan.MAX_STRIDES)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     bf = bench_sub.add_parser(

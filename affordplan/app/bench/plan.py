@@ -32,7 +32,7 @@ from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.robot import SKILLS
 from affordplan.world import Box, Workspace
 from planner.graph import RestingStateGraph
-from planner.plan import CLEARANCE, inflated_footprints, make_checkers
+from planner.plan import CLEARANCE, MAX_STRIDES, inflated_footprints, make_checkers
 from planner.predict import Predictor
 from primitives.skills import load_skills
 
@@ -81,7 +81,8 @@ class TaskResult:
     max_planning_time: float = float("nan")  # the longest of the first plan and the replans, seconds
     object_name: str = ""
     # the first plan's steps as its odds see them: (skill, predicted success of one try); empty for greedy
-    steps: list[tuple[str, float]] = field(default_factory=list)
+    steps: list[tuple] = field(default_factory=list)
+    strokes: int = 0  # fingertip strokes over the execution's calls (a push of several strides may make more than one)
 
 
 @dataclass
@@ -104,6 +105,8 @@ class BenchReport:
                     mean_primitives=float(np.mean(primitives)),
                     median_primitives=float(np.median(primitives)),
                     p90_primitives=float(np.percentile(primitives, 90)),
+                    mean_strokes=float(np.mean([r.strokes for r in rs])),
+                    median_strokes=float(np.median([r.strokes for r in rs])),
                     calibration=plan_calibration([r.p_success for r in rs], [r.success for r in rs]),
                     mean_replans=float(np.mean([r.replans for r in rs])),
                     success_by_scene={s: float(np.mean([r.success for r in rs if r.scene == s]))
@@ -124,7 +127,8 @@ class BenchReport:
             lines.append(f"{s['planner']:10s} {s['tasks']:5d} {s['success']:8.2f} "
                          f"{1e3 * s['median_planning_time_s']:10.0f} / {1e3 * s['max_planning_time_s']:6.0f} ms "
                          f"{s['mean_primitives']:17.1f} / {s['median_primitives']:4.0f} / {s['p90_primitives']:4.0f} "
-                         f"{s['mean_replans']:13.1f}  {scenes}; rare goal {rare_text}")
+                         f"{s['mean_replans']:13.1f}  {scenes}; rare goal {rare_text}; fingertip strokes (mean / "
+                         f"median) {s['mean_strokes']:.1f} / {s['median_strokes']:.0f}")
         for s in summaries:
             cal = s["calibration"]
             if cal["plans"]:
@@ -225,16 +229,18 @@ def plan_calibration(predicted: Sequence[float], reached: Sequence[bool], bins: 
 
 
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
-             max_primitives: int, time_limit: float, log: Callable[[str], None] | None = None) -> TaskResult:
+             max_primitives: int, time_limit: float, log: Callable[[str], None] | None = None,
+             max_strides: int = MAX_STRIDES) -> TaskResult:
     """Plan and execute ``task`` with one planner; ``log``, when given, receives the first plan and the
-    execution's step log (:class:`planner.execute.Execution`) as text."""
+    execution's step log (:class:`planner.execute.Execution`) as text. ``max_strides``: as
+    :func:`planner.api.plan`."""
     from planner.api import plan as make_plan
 
     p_goal = float(obj.resting_states[task.goal.resting_state].probability)
     t0 = time.perf_counter()
     try:
         p = make_plan(obj, task.goal, start=task.start, obstacles=task.obstacles, time_limit=time_limit,
-                      planner=planner_name, seed=seed, predictor=predictor)
+                      planner=planner_name, seed=seed, predictor=predictor, max_strides=max_strides)
     except AffordplanError as exc:
         if log is not None:
             log(f"{planner_name}: no plan: {exc}")
@@ -255,7 +261,8 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
     return TaskResult(planner_name, task.scene, ex.success, first, ex.n_primitives, ex.replans, ex.reason, p_goal,
                       float(xy_error), float(yaw_error), missed, p_success=predicted[0],
                       expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name,
-                      steps=p.planner.odds_steps(p.steps) if planner_name == "affordplan" else [])
+                      steps=p.planner.odds_steps(p.steps) if planner_name == "affordplan" else [],
+                      strokes=ex.strokes)
 
 
 def _describe(task: Task) -> str:
@@ -279,8 +286,8 @@ def task_seed(seed: int, task: int | None, draw: int = 0) -> int:
 def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("affordplan", "greedy"),
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
                only: Sequence[int] | None = None, log: Callable[[str], None] | None = None,
-               weights_dir: str | os.PathLike | None = None, draw: int = 0, objects: str = "procedural"
-               ) -> BenchReport:
+               weights_dir: str | os.PathLike | None = None, draw: int = 0, objects: str = "procedural",
+               max_strides: int = MAX_STRIDES) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring).
 
     ``draw``: 0 runs the standard bench; ``k > 0`` runs the same tasks (objects, scenes, starts, goals) with the
@@ -293,6 +300,10 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     candidate set of weights before shipping it.
 
     ``objects``: the tasks' objects, one of :data:`OBJECT_SETS` (:func:`task_object`).
+
+    ``max_strides``: the 5 cm strides one push call of the affordplan planner may make (:func:`planner.api.plan`);
+    1 benches pushes of one stroke each, as until 0.24. Each task reports its calls (``primitives``) and its
+    fingertip strokes.
 
     ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
     run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
@@ -320,7 +331,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
             if log is not None:
                 log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")
             result = run_task(task, obj, name, sim, predictor, task_seed(seed, i, draw), max_primitives, time_limit,
-                              log)
+                              log, max_strides)
             result.task = i
             report.results.append(result)
         bar.update(1)
