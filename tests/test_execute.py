@@ -199,3 +199,22 @@ def test_a_plans_p_success_falls_when_a_skill_is_forced_to_fail():
     assert [s.skill for s in sure.steps] == [s.skill for s in failing.steps]
     assert sure.p_success > 0.99 and failing.p_success < sure.p_success - 0.3
     assert failing.expected_primitives > sure.expected_primitives
+
+
+def test_a_push_of_several_strides_is_one_primitive_of_several_strokes():
+    cube = ap.load_object("cube")
+    T0, goal = cube.resting_states[0].pose((0.40, -0.1), 0.0), ap.Goal(xy=(0.70, 0.1))
+    runs = {}
+    for k in (1, 4):
+        skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+        plan = Planner(cube, predictor=StubPredictor(skills), seed=0, max_strides=k).plan(T0, goal)
+        sim = ap.Simulator(cube, seed=0)
+        sim.set_object_pose(T0, settle=False)
+        ex = execute_plan(plan, sim=sim, max_primitives=30)
+        assert ex.success, str(ex)
+        assert ex.strokes == sum(len(s.calls) for s in skills.values())  # every stroke counted once
+        runs[k] = ex
+    # no more strokes than one per stride (a last stroke within STOP_WITHIN of the target is left out)
+    assert runs[4].n_primitives < runs[1].n_primitives and runs[4].strokes <= runs[1].strokes
+    assert any(e.strokes > 1 for e in runs[4].log) and all(e.strokes == 1 for e in runs[1].log)
+    assert "strokes" in str(runs[4])

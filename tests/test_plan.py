@@ -329,3 +329,32 @@ def test_a_plans_odds_count_the_risk_that_pushes_in_a_rare_state_tip_the_object(
             assert plan.p_success == bare.p_success
     assert mug.resting_states[2].probability < 0.1 < mug.resting_states[0].probability
     assert tips[2] > 0.1 and tips[0] == 0.0
+
+
+def test_a_straight_run_of_pushes_is_made_as_pushes_of_up_to_max_strides():
+    """merge_strides: consecutive pushes along one direction become one call of up to max_strides strides, from
+    where the run starts to where it ends; everything else is left as it was."""
+    from planner.plan import merge_strides
+
+    cube = ap.load_object("cube")
+    T0, goal = cube.resting_states[0].pose((0.40, -0.1), 0.0), ap.Goal(xy=(0.70, 0.1), yaw=1.0)
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    plans = {k: Planner(cube, predictor=StubPredictor(skills), seed=0, max_strides=k).plan(T0, goal) for k in (1, 4)}
+    unit, merged = plans[1].steps, plans[4].steps
+    assert all(s.strides == 1 for s in unit) and max(s.strides for s in merged) > 1
+    assert all(s.strides <= 4 for s in merged) and len(merged) < len(unit)
+    assert sum(s.strides for s in merged) == len(unit)
+    assert [(s.skill, s.params, s.strides) for s in merge_strides(unit, 4)] == \
+        [(s.skill, s.params, s.strides) for s in merged]
+    i = 0
+    for s in merged:  # each merged push spans its strides: the first one's start, the last one's end
+        np.testing.assert_allclose(s.start_pose, unit[i].start_pose)
+        np.testing.assert_allclose(s.expected_pose, unit[i + s.strides - 1].expected_pose)
+        if s.strides > 1:
+            run = [u.params["direction"] for u in unit[i:i + s.strides]]
+            assert s.skill == "push" and max(abs(wrap_angle(d - run[0])) for d in run) <= math.radians(3.0)
+        i += s.strides
+    assert plans[4].p_success >= plans[1].p_success and \
+        plans[4].expected_primitives < plans[1].expected_primitives
+    with pytest.raises(ap.errors.InputError):
+        Planner(cube, predictor=StubPredictor(skills), max_strides=0)
