@@ -229,11 +229,11 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
                 break
         step = steps[k]
         skill = skills[step.skill]
-        strokes = 1
+        strokes, note = 1, ""
         try:
             if step.skill == "push" and step.strides > 1:
                 made = push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides, step.params["direction"])
-                out, strokes = made.outcome, made.strokes
+                out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
             else:
                 out = skill.execute(sim, step.params)
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
@@ -245,7 +245,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         if not made_progress(obj, step.skill, step.params, out.pose_before, out.pose_after):
             planner.record_failure(step.skill, step.params, T)
         log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
-                            out.pose_after, replanned, step.p_success, states=_states(obj, out.pose_before,
+                            out.pose_after, replanned, step.p_success, note, _states(obj, out.pose_before,
                                                                                       out.pose_after),
                             strokes=strokes))
         _record_frame(sim, render, frames)

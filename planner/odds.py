@@ -27,6 +27,10 @@ step makes no progress however often it is tried. The rates ``r``, one per skill
 training objects (:data:`STUCK_RATES`, :func:`fit_stuck_rates`). Stuck draws are independent of progress draws, so
 ``p_success`` is the product of the stuck-free odds and every step's ``1 - r * (1 - q)``.
 
+**Pushes of several strides.** A straight run of pushes is made as calls of up to four 5 cm strides that correct
+their course between strokes (:func:`primitives.strokes.push_to`): such a call is one primitive of the budget however
+many strokes it makes, and :func:`mc_odds` draws its strokes within it.
+
 **Tips.** A push or spin in a resting state that few drops come to rest in may knock the object into another state
 (a hard drive on its edge falls flat; the outcome model's :meth:`~primitives.outcome_model.OutcomeModel.p_tip`).
 Closed-loop execution then replans from the new state and sometimes rolls back, but often not within the budget.
@@ -57,12 +61,12 @@ Q_FLOOR = 0.02  # a step rated below this is treated as this: the executor repla
 # `affordplan bench plan --objects training` runs (`affordplan bench fit-stuck`; training objects only; the
 # commands and the figures: docs/guide.md, "What a plan predicts").
 # 0.24.0, with pushes of up to four strides per call (planner.plan.MAX_STRIDES): `affordplan bench fit-stuck
-# runs/train_s100.json ... runs/train_s107.json`, eight runs of `affordplan bench plan --tasks 24 --sim arm --planner
-# affordplan --objects training --seed S --json` (S = 100-107), 191 plans, 0.75 reached, fitted with TIP_FATAL: Brier
-# 0.105 (0.184 with neither stuck steps nor tips). Fitted on four runs and scored on the other four: 0.120 and 0.138
-# (the halves fit roll 1.0 and 0.0: 191 plans pin the rates loosely). Before strides, the same runs fitted push 0.0,
-# roll 0.6, spin 0.2, fatal tips 0.2 (Brier 0.104); before tips, push 0.0, roll 0.9, spin 0.3.
-STUCK_RATES: dict[str, float] = {"push": 0.0, "roll": 0.7, "spin": 0.2}
+# runs/train_s100.json ... runs/train_s115.json`, sixteen runs of `affordplan bench plan --tasks 24 --sim arm --planner
+# affordplan --objects training --seed S --json` (S = 100-115), 383 plans, 0.76 reached, fitted with TIP_FATAL: Brier
+# 0.104 (0.188 with neither stuck steps nor tips). Fitted on S = 100-107 and scored on 108-115: 0.101 (roll 0.7,
+# spin 0.2); the other way round: 0.110 (roll 0.8, spin 0.1). Before strides, S = 100-107 fitted push 0.0, roll 0.6,
+# spin 0.2, fatal tips 0.2 (Brier 0.104); before tips, push 0.0, roll 0.9, spin 0.3.
+STUCK_RATES: dict[str, float] = {"push": 0.0, "roll": 0.8, "spin": 0.2}
 # The share of tips (a push or spin that leaves the object in another resting state) after which a run does not
 # reach the goal; fitted with STUCK_RATES (fit_odds), the record beside them.
 TIP_FATAL = 0.3
@@ -112,9 +116,12 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
             stuck_rate: float | Mapping[str, float] | None = None, tip_fatal: float | None = None) -> Odds:
     """The :class:`Odds` of a plan by Monte Carlo through the skills' outcome models.
 
-    ``steps``: the plan's ``(skill, strict p)`` or ``(skill, strict p, tip)`` in order (``tip``: the probability
-    that one try leaves the object in another resting state, 0 when not given); ``models``: an outcome model per
-    skill used, anything with ``sample_progress(p, rng, n)`` (:class:`primitives.outcome_model.OutcomeModel`).
+    ``steps``: the plan's ``(skill, strict p)``, ``(skill, strict p, tip)`` or ``(skill, strict p, tip, strides)``
+    in order (``tip``: the probability that one try leaves the object in another resting state, 0 when not given;
+    ``strides``: a push of k > 1 strides, :class:`planner.plan.Step`, counts as k steps made by one call of up to
+    k + ``EXTRA_STROKES`` strokes, each stroke drawn as a primitive is below, the call ending when its strides are
+    covered; 1 when not given); ``models``: an outcome model per skill used, anything with
+    ``sample_progress(p, rng, n)`` (:class:`primitives.outcome_model.OutcomeModel`).
 
     Model: every step asks for one unit of its skill's effect (a push 5 cm, a spin its angle, a roll its state).
     Each of ``n`` runs spends primitives on its current step; a primitive draws a progress for that step's ``p``
@@ -125,7 +132,7 @@ def mc_odds(steps: Sequence[tuple[str, float] | tuple[str, float, float]], model
     primitives, ``expected_primitives`` their mean, counting a run that is not done as ``budget``. In each run, each
     step is stuck (makes no progress at all) with probability ``r * (1 - p)``, ``r`` its skill's entry of
     ``stuck_rate`` (a number: the same for every skill; ``None``: :data:`STUCK_RATES`; the module docstring). Each
-    primitive spent on a step with tip probability ``t`` loses its run (it never finishes) with probability
+    stroke made on a step with tip probability ``t`` loses its run (it never finishes) with probability
     ``tip_fatal * t`` (``None``: :data:`TIP_FATAL`).
 
     Each step's draws come from a pool of ``n`` samples of its model drawn once (``sample_progress(p, rng, n)``),
