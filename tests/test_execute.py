@@ -79,16 +79,30 @@ def test_a_place_where_rolls_failed_twice_is_left_for_another():
     assert math.hypot(where[-1][0] - 0.45, where[-1][1]) > 0.04
 
 
-def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
-    """Pushes towards the goal fail, and so does one side of the detour round them: neither is tried a third time.
+class WhereIdeal(IdealSkill):
+    """An ideal skill that also records where (x, y) each call was made."""
+
+    def __init__(self, name, fail=lambda params, state: False):
+        super().__init__(name, fail)
+        self.where = []
+
+    def execute(self, sim, params):
+        self.where.append(tuple(np.round(sim.object_pose()[:2, 3], 4)))
+        return super().execute(sim, params)
+
+
+def test_a_push_that_failed_twice_is_not_repeated_there_under_a_detour():
+    """Pushes towards the goal fail, and so does one side of the detour round them: neither is tried a third time
+    where it failed.
 
     The detour round a failing push is a push on each side of it; a detour direction that has itself failed
-    twice is turned further, instead of being planned (and failing) again on every replan.
+    twice is turned further, instead of being planned (and failing) again on every replan. Failures count where they
+    happened (``PUSH_FAILURE_RADIUS``): once the object has moved on, the direction is tried again.
     """
     cube = ap.load_object("cube")
     failing = lambda params, state: -10.0 <= math.degrees(params["direction"]) <= 40.0  # noqa: E731
     skills = {n: IdealSkill(n) for n in ("spin", "roll")}
-    skills["push"] = IdealSkill("push", fail=failing)
+    skills["push"] = WhereIdeal("push", fail=failing)
     planner = Planner(cube, (), predictor=StubPredictor(skills), time_limit=5.0, seed=0)
     goal = ap.Goal(xy=(0.62, 0.0), resting_state=0)
     plan = planner.plan(cube.resting_states[0].pose((0.45, 0.0), 0.0), goal)
@@ -96,14 +110,31 @@ def test_a_push_that_failed_twice_is_not_repeated_under_a_detour():
     sim.set_object_pose(plan.start_pose, settle=False)
     ex = execute_plan(plan, sim=sim, max_primitives=40)
     assert ex.success, str(ex)
-    failed = [round(math.degrees(c[1]["direction"])) for c in skills["push"].calls if failing(c[1], c[0])]
-    buckets = [round(d / 45.0) for d in failed]  # the planner remembers failures per 45 deg sector
-    assert all(buckets.count(b) <= 2 for b in set(buckets)), failed
+    push = skills["push"]
+    failed = [(round(math.degrees(c[1]["direction"])), xy) for c, xy in zip(push.calls, push.where)
+              if failing(c[1], c[0])]
+    # the planner remembers failures per 45 deg sector, where they happened
+    places = [(round(d / 45.0), xy) for d, xy in failed]
+    assert all(places.count(p) <= 2 for p in set(places)), failed
     # straight at the goal (0 deg) twice, then the detour's side that also fails (its first turn, 35 deg) twice;
-    # the other side (-35 deg) and wider turns carry the object on
+    # the other side (-35 deg) carries the object on
     near = round(math.degrees(DETOUR_ANGLES[0]))
-    assert failed == [0, 0, near, near], failed
-    assert all(not failing(params, state) for state, params in skills["push"].calls[len(failed):])
+    assert [d for d, _ in failed[:4]] == [0, 0, near, near] and len({xy for _, xy in failed[:4]}) == 1, failed
+
+
+def test_push_failures_count_where_they_happened():
+    cube = ap.load_object("cube")
+    planner = ideal_planner(cube)
+    here, there = cube.resting_states[0].pose((0.45, 0.0), 0.0), cube.resting_states[0].pose((0.52, 0.0), 0.0)
+    push = {"direction": 0.0}
+    assert planner.record_failure("push", push, here) == 1 and planner.record_failure("push", push, here) == 2
+    assert planner.memory.avoided("push", push, here) and not planner.memory.avoided("push", push, there)
+    assert planner.record_failure("push", push, there) == 1
+    # spins and rolls are remembered wherever they failed
+    spin = {"angle": 0.5}
+    planner.record_failure("spin", spin, here)
+    planner.record_failure("spin", spin, here)
+    assert planner.memory.avoided("spin", spin, there)
 
 
 def test_failure_memory_counts_calls_that_did_not_move_the_object_as_asked():

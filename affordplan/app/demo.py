@@ -313,8 +313,8 @@ def outcome_lines(run: SceneRun, obj: ObjectModel) -> list[str]:
     def verdict(ok: bool) -> str:
         return "ok" if ok else "NOT met"
 
-    lines = [f"outcome: goal {'REACHED' if ex.success else 'NOT reached'} after {ex.n_primitives} primitives, "
-             f"{ex.replans} replans ({ex.reason})",
+    lines = [f"outcome: goal {'REACHED' if ex.success else 'NOT reached'} after {ex.n_primitives} primitives "
+             f"({ex.strokes} fingertip strokes), {ex.replans} replans ({ex.reason})",
              f"  position error {100 * run.xy_error:.1f} cm (tolerance {100 * g.xy_tol:.1f} cm): "
              f"{verdict(run.xy_error <= g.xy_tol)}"]
     if g.yaw is not None:
@@ -340,12 +340,13 @@ def summary(run: SceneRun, obj: ObjectModel) -> dict:
         "plan": {"kind": plan.kind, "route": [int(r) for r in plan.route], "p_success": _finite(plan.p_success),
                  "expected_primitives": _finite(plan.expected_primitives), "p_steps": _finite(plan.p_steps),
                  "planning_time_s": plan.planning_time,
-                 "steps": [{"skill": s.skill, "params": _plain(s.params), "p_success": _finite(s.p_success)}
-                           for s in plan.steps]},
-        "execution": {"success": bool(ex.success), "n_primitives": ex.n_primitives, "replans": ex.replans,
+                 "steps": [{"skill": s.skill, "params": _plain(s.params), "p_success": _finite(s.p_success),
+                            "strides": s.strides} for s in plan.steps]},
+        "execution": {"success": bool(ex.success), "n_primitives": ex.n_primitives, "strokes": ex.strokes,
+                      "replans": ex.replans,
                       "reason": ex.reason,
                       "log": [{"skill": e.skill, "params": _plain(e.params), "success": e.success, "valid": e.valid,
-                               "replanned": e.replanned, "note": e.note} for e in ex.log]},
+                               "replanned": e.replanned, "note": e.note, "strokes": e.strokes} for e in ex.log]},
         "final": {"resting_state": int(state), "xy": [float(x), float(y)], "yaw": float(yaw),
                   "xy_error_m": run.xy_error, "yaw_error_rad": run.yaw_error, "state_ok": bool(run.state_ok)},
         "off_table": [{"after_primitive": k, "lowest_point_m": h} for k, h in run.off_table],
