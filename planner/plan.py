@@ -127,9 +127,9 @@ class Step:
 
 
 def merge_strides(steps: Sequence[Step], max_strides: int) -> list[Step]:
-    """``steps`` with each run of consecutive pushes along one direction (within ``MERGE_ANGLE`` of the run's
-    first) made into pushes of up to ``max_strides`` strides: one call each, executed with course corrections
-    between its strokes (:func:`primitives.strokes.push_to`). A merged push starts where its run starts, is
+    """``steps`` with each run of consecutive pushes along one direction (each within ``MERGE_ANGLE`` of the heading
+    of the run merged so far) made into pushes of up to ``max_strides`` strides: one call each, executed with course
+    corrections between its strokes (:func:`primitives.strokes.push_to`). A merged push starts where its run starts, is
     expected where it ends, heads from the one to the other, and is rated by the mean of its strides' ratings (one
     stroke's). ``max_strides`` 1 leaves the steps as they are."""
     out: list[Step] = []
