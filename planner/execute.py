@@ -3,8 +3,8 @@
 :func:`execute_plan` runs a :class:`planner.plan.Plan` in a simulator: observe the object's pose; if
 the goal is reached, stop; if the pose is off the plan (more than ``XY_TOL`` / ``YAW_TOL`` from where
 the next step expects it, or in another resting state), replan from the observed pose; execute the
-next step's skill with its parameter (a push or spin of several strides is one call that corrects its course
-between strokes, :mod:`primitives.strokes`); remember failures (calls that did not move the object the way
+next step's skill with its parameter (a push of several strides is one call that corrects its course between
+strokes, :func:`primitives.strokes.push_to`); remember failures (calls that did not move the object the way
 they asked: :func:`made_progress`), so that a (state, skill, parameter) that failed twice is avoided
 by the next plan. It stops on success, on ``max_primitives``, or when no plan
 can be found.
@@ -34,7 +34,7 @@ from planner.predict import expected_pose
 from primitives import params as skill_params
 from primitives.params import made_progress
 from primitives.skills import Skill, skills_sensor
-from primitives.strokes import push_to, spin_to
+from primitives.strokes import push_to
 
 if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its plans
     from planner.plan import Planner
@@ -231,10 +231,8 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         skill = skills[step.skill]
         strokes, note = 1, ""
         try:
-            if step.strides > 1 and step.skill in ("push", "spin"):
-                made = (push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides, step.params["direction"])
-                        if step.skill == "push" else
-                        spin_to(skill, sim, obj.planar_pose(step.expected_pose)[3], step.strides, step.params["angle"]))
+            if step.skill == "push" and step.strides > 1:
+                made = push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides, step.params["direction"])
                 out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
             else:
                 out = skill.execute(sim, step.params)

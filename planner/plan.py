@@ -75,9 +75,9 @@ ARM_REACH = FINGERTIP_REACH - 0.025  # 0.79 m
 # Radius (metres) of the disc kept clear of obstacles where the fingertip comes down behind an object to push
 # it (Planner.push_blocked): the tip's, plus a margin.
 FINGER_ROOM = TIP_RADIUS + 0.006
-# A straight run of pushes is made as pushes of up to MAX_STRIDES 5 cm strides each, and a run of spins the same way
-# as spins of up to MAX_STRIDES turns, one call apiece that corrects its course between strokes (merge_strides,
-# primitives.strokes); pushes whose directions differ by no more than MERGE_ANGLE count as one run.
+# A straight run of pushes is made as pushes of up to MAX_STRIDES 5 cm strides each, one call apiece that corrects
+# its course between strokes (merge_strides, primitives.strokes); pushes whose directions differ by no more than
+# MERGE_ANGLE count as one run.
 MAX_STRIDES = 4
 MERGE_ANGLE = math.radians(3.0)
 
@@ -92,10 +92,9 @@ class Step:
             value (:class:`~primitives.params.PushParams` ...), its dict is kept; :attr:`typed_params` reads it typed.
         start_pose, expected_pose: 4x4 world poses before and (ideally) after.
         p_success: the skill's predicted success at ``start_pose`` (of one stroke, for a push of several strides).
-        strides: a push's 5 cm strides (``PUSH_STEP``) along its direction, or a spin's turns of ``params``' angle,
-            made as one call that corrects its course between strokes (:func:`primitives.strokes.push_to` and
-            :func:`~primitives.strokes.spin_to`, to ``expected_pose``); 1 for a roll, and for a push or spin of one
-            stride, which is one stroke.
+        strides: a push's 5 cm strides (``PUSH_STEP``) along its direction, made as one call that corrects its
+            course between strokes (:func:`primitives.strokes.push_to`, to ``expected_pose``); 1 for every other
+            call, and for a push of one stride, which is one stroke.
     """
 
     skill: SkillName
@@ -129,27 +128,22 @@ class Step:
 
 def merge_strides(steps: Sequence[Step], max_strides: int) -> list[Step]:
     """``steps`` with each run of consecutive pushes along one direction (each within ``MERGE_ANGLE`` of the heading
-    of the run merged so far), and each run of consecutive spins the same way, made into calls of up to
-    ``max_strides`` strides each, executed with course corrections between their strokes
-    (:func:`primitives.strokes.push_to`, :func:`~primitives.strokes.spin_to`). A merged call starts where its run
-    starts, is expected where it ends, and is rated by the mean of its strides' ratings (one stroke's); a merged
-    push heads from its start to its end, a merged spin keeps its first turn's angle. ``max_strides`` 1 leaves the
-    steps as they are."""
+    of the run merged so far) made into pushes of up to ``max_strides`` strides: one call each, executed with course
+    corrections between its strokes (:func:`primitives.strokes.push_to`). A merged push starts where its run starts, is
+    expected where it ends, heads from the one to the other, and is rated by the mean of its strides' ratings (one
+    stroke's). ``max_strides`` 1 leaves the steps as they are."""
     out: list[Step] = []
     for s in steps:
         last = out[-1] if out else None
-        if last is None or s.skill != last.skill or last.strides >= max_strides or not (
-                (s.skill == "push" and abs(float(wrap_angle(s.params["direction"] - last.params["direction"])))
-                 <= MERGE_ANGLE) or (s.skill == "spin" and s.params["angle"] * last.params["angle"] > 0.0)):
-            out.append(s)
-            continue
-        n = last.strides + s.strides
-        p = (last.p_success * last.strides + s.p_success * s.strides) / n
-        params = dict(last.params)
-        if s.skill == "push":
+        if (last is not None and s.skill == "push" and last.skill == "push" and last.strides < max_strides
+                and abs(float(wrap_angle(s.params["direction"] - last.params["direction"]))) <= MERGE_ANGLE):
             dx, dy = s.expected_pose[:2, 3] - last.start_pose[:2, 3]
-            params["direction"] = math.atan2(dy, dx) if math.hypot(dx, dy) > 1e-9 else last.params["direction"]
-        out[-1] = Step(s.skill, params, last.start_pose, s.expected_pose, p, n)
+            n = last.strides + s.strides
+            p = (last.p_success * last.strides + s.p_success * s.strides) / n
+            heading = math.atan2(dy, dx) if math.hypot(dx, dy) > 1e-9 else last.params["direction"]
+            out[-1] = Step("push", {"direction": heading}, last.start_pose, s.expected_pose, p, n)
+        else:
+            out.append(s)
     return out
 
 

@@ -1,4 +1,4 @@
-"""Skills that correct their course between strokes: a push to a point on the table, a spin to a yaw, one call each.
+"""A push that corrects its course between strokes: one call that moves the object to a point on the table.
 
 The push skill's one stroke moves an object about 5 cm (:data:`primitives.params.PUSH_STEP`; the policies
 move it 5-9 cm) and drifts sideways as it goes. A straight run of a plan is several such strides. Made as one
@@ -7,11 +7,6 @@ the run one call instead, as DESIGN.md's decisions allow (a skill may re-observe
 stroke it observes the object, aims the stroke at the run's end from where the object now lies, and stops when
 the object is within ``STOP_WITHIN`` of it, has passed it, has left its resting state or turned, has not moved,
 or the strokes are spent (the run's strides, plus :data:`EXTRA_STROKES`).
-
-:func:`spin_to` does the same for a turn bigger than one spin (15-45 deg): before each stroke it asks the spin
-skill for the rest of the turn (clipped to 15-45 deg) and stops within ``YAW_WITHIN`` of the yaw, past it, when a
-stroke turned the object less than ``MIN_SPIN_SHARE`` of its asked turn or the wrong way, shifted it more than
-``STOP_WITHIN`` from where the call began, or left its resting state, or when the strokes are spent.
 
 Frames and units: positions are world x, y on the table in metres, directions world headings in radians.
 """
@@ -28,7 +23,7 @@ import numpy as np
 from affordplan.checks import as_finite, as_whole
 from affordplan.errors import AffordplanError, InputError
 from affordplan.geometry import wrap_angle
-from primitives.params import SPIN_MAX, SPIN_MIN, made_progress
+from primitives.params import made_progress
 
 if TYPE_CHECKING:
     from affordplan.sim.simulator import Outcome, Simulator
@@ -37,7 +32,6 @@ if TYPE_CHECKING:
 EXTRA_STROKES = 1  # strokes a call may take beyond its strides (one stroke that fell short)
 STOP_WITHIN = 0.025  # metres from the target at which the strokes stop (the executor's XY_TOL)
 MAX_TURN = math.radians(12.0)  # a stroke that turned the object more than this ends the call (the executor's YAW_TOL)
-YAW_WITHIN = math.radians(10.0)  # radians from the asked yaw at which a spin's strokes stop (the planner's dead band)
 
 
 @dataclass
@@ -115,68 +109,4 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
     combined.pose_before = first.pose_before
     s1, x1, y1, _ = obj.planar_pose(out.pose_after)
     combined.success = bool(out.valid and s1 == state and math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN)
-    return Strokes(combined, n, stopped)
-
-
-def spin_to(skill: Skill, sim: Simulator, target_yaw: float, strides: int, angle: float | None = None) -> Strokes:
-    """Turn the object in ``sim`` about the vertical to ``target_yaw`` (radians, its resting state's yaw,
-    :meth:`affordplan.objects.model.ObjectModel.planar_pose`) with up to ``strides + EXTRA_STROKES`` strokes of the
-    spin ``skill``, observing before each (module docstring).
-
-    ``angle``: the first stroke's signed turn (radians, 15-45 deg; default: the rest of the turn, clipped); later
-    strokes ask for the rest of the turn from the yaw the object is at. The yaw is reached when it is within
-    ``YAW_WITHIN``; the call goes the way of the first stroke and stops when a stroke carried the object past the
-    yaw by more than that. An error in a later stroke ends the call with the strokes made; in the first, it is
-    raised.
-
-    Raises:
-        InputError: a target yaw that is not finite, ``strides`` not a whole number from 1 to 100, or a skill that
-            is not the spin.
-    """
-    if skill.name != "spin":
-        raise InputError(f"spin_to takes the spin skill, got {skill.name!r}")
-    target = as_finite("target yaw (radians)", target_yaw)
-    strides = as_whole("strides", strides, 1, 100)
-    obj = sim.obj
-    state, x0, y0, yaw = obj.planar_pose(sim.object_pose())
-    sense = math.copysign(1.0, float(angle) if angle is not None else float(wrap_angle(target - yaw)))
-    first, out, stopped, n = None, None, "strokes spent", 0
-    for n in range(1, strides + EXTRA_STROKES + 1):
-        rest = float(wrap_angle(target - obj.planar_pose(sim.object_pose())[3]))
-        asked = float(angle) if n == 1 and angle is not None else \
-            math.copysign(min(max(abs(rest), SPIN_MIN), SPIN_MAX), rest)
-        try:
-            stroke = skill.execute(sim, {"angle": asked})
-        except AffordplanError as exc:
-            if out is None:
-                raise
-            n -= 1
-            stopped = f"no stroke: {exc}"
-            break
-        out, first = stroke, first or stroke
-        s1, x1, y1, yaw1 = obj.planar_pose(out.pose_after)
-        rest = float(wrap_angle(target - yaw1))
-        if not out.valid:
-            stopped = f"invalid stroke ({out.invalid_reason})"
-            break
-        if s1 != state:
-            stopped = "left its resting state"
-            break
-        if not made_progress(obj, "spin", {"angle": asked}, out.pose_before, out.pose_after):
-            stopped = "did not turn"
-            break
-        if math.hypot(x1 - x0, y1 - y0) > STOP_WITHIN:
-            stopped = "shifted"
-            break
-        if abs(rest) <= YAW_WITHIN:
-            stopped = "at the yaw"
-            break
-        if rest * sense < 0.0:
-            stopped = "passed the yaw"
-            break
-    assert out is not None and first is not None  # the loop makes at least one stroke
-    combined = copy.copy(out)
-    combined.pose_before = first.pose_before
-    s1, _, _, yaw1 = obj.planar_pose(out.pose_after)
-    combined.success = bool(out.valid and s1 == state and abs(float(wrap_angle(target - yaw1))) <= YAW_WITHIN)
     return Strokes(combined, n, stopped)

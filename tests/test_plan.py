@@ -147,7 +147,7 @@ def test_a_goal_yaw_is_met_modulo_the_objects_symmetry():
     plan = planner.plan(T0, ap.Goal(xy=(0.6, 0.05), yaw=math.radians(95.0), resting_state=0))
     assert "spin" not in [s.skill for s in plan.steps]
     labelled = planner.plan(T0, ap.Goal(xy=(0.6, 0.05), yaw=math.radians(95.0), resting_state=0, yaw_symmetric=False))
-    spins = [s.params["angle"] * s.strides for s in labelled.steps if s.skill == "spin"]  # strides: turns of angle
+    spins = [s.params["angle"] for s in labelled.steps if s.skill == "spin"]
     assert abs(math.degrees(sum(spins)) - 95.0) <= 10.0
     sim = ap.Simulator(cube, seed=0)
     sim.set_object_pose(T0, settle=False)
@@ -339,10 +339,6 @@ def test_a_straight_run_of_pushes_is_made_as_pushes_of_up_to_max_strides():
     cube = ap.load_object("cube")
     T0, goal = cube.resting_states[0].pose((0.40, -0.1), 0.0), ap.Goal(xy=(0.70, 0.1), yaw=1.0)
     skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
-    box = ap.load_object("lunch_box")  # not symmetric under a quarter turn: a quarter turn is two spins
-    turn = Planner(box, predictor=StubPredictor(skills), seed=0).plan(box.resting_states[0].pose((0.5, 0.0), 0.0),
-                                                                       ap.Goal(xy=(0.5, 0.0), yaw=math.radians(90)))
-    assert [(s.skill, s.strides) for s in turn.steps] == [("spin", 2)]
     plans = {k: Planner(cube, predictor=StubPredictor(skills), seed=0, max_strides=k).plan(T0, goal) for k in (1, 4)}
     unit, merged = plans[1].steps, plans[4].steps
     assert all(s.strides == 1 for s in unit) and max(s.strides for s in merged) > 1
@@ -354,14 +350,9 @@ def test_a_straight_run_of_pushes_is_made_as_pushes_of_up_to_max_strides():
     for s in merged:  # each merged push spans its strides: the first one's start, the last one's end
         np.testing.assert_allclose(s.start_pose, unit[i].start_pose)
         np.testing.assert_allclose(s.expected_pose, unit[i + s.strides - 1].expected_pose)
-        run = unit[i:i + s.strides]
-        assert all(u.skill == s.skill for u in run) and s.skill != "roll" or s.strides == 1
-        if s.strides > 1 and s.skill == "push":
-            headings = [u.params["direction"] for u in run]
-            assert max(abs(wrap_angle(d - headings[0])) for d in headings) <= math.radians(6.0)
-        if s.strides > 1 and s.skill == "spin":  # one way, the first turn's angle
-            assert len({math.copysign(1, u.params["angle"]) for u in run}) == 1
-            assert s.params["angle"] == run[0].params["angle"]
+        if s.strides > 1:
+            run = [u.params["direction"] for u in unit[i:i + s.strides]]
+            assert s.skill == "push" and max(abs(wrap_angle(d - run[0])) for d in run) <= math.radians(3.0)
         i += s.strides
     assert plans[4].p_success >= plans[1].p_success and \
         plans[4].expected_primitives < plans[1].expected_primitives

@@ -1,4 +1,4 @@
-"""Skills that correct their course between strokes (primitives.strokes: push_to, spin_to)."""
+"""A push that corrects its course between strokes (primitives.strokes.push_to)."""
 
 import math
 
@@ -8,10 +8,10 @@ from planner_fakes import IdealSkill
 
 import affordplan as ap
 from affordplan.errors import InputError
-from affordplan.geometry import rot_z, wrap_angle
+from affordplan.geometry import rot_z
 from affordplan.sim.simulator import Outcome
 from primitives.params import PUSH_STEP
-from primitives.strokes import EXTRA_STROKES, STOP_WITHIN, YAW_WITHIN, push_to, spin_to
+from primitives.strokes import EXTRA_STROKES, STOP_WITHIN, push_to
 
 
 class Veering(IdealSkill):
@@ -104,43 +104,3 @@ def test_bad_requests_are_refused(sim):
         push_to(IdealSkill("push"), sim, (0.57, 0.0, 0.0), strides=2)
     with pytest.raises(InputError):
         push_to(IdealSkill("push"), sim, (0.57, 0.0), strides=0)
-
-
-# ------------------------------------------------------------------ spin_to
-class Turning(IdealSkill):
-    """A spin that turns the object ``share`` of the asked angle, in place."""
-
-    def __init__(self, share: float):
-        super().__init__("spin")
-        self.share = share
-
-    def execute(self, sim, params):
-        return super().execute(sim, {"angle": self.share * params["angle"]})
-
-
-def _yaw(sim):
-    return sim.obj.planar_pose(sim.object_pose())[3]
-
-
-def test_an_ideal_spin_reaches_a_yaw_three_turns_away_in_one_call(sim):
-    skill = IdealSkill("spin")
-    made = spin_to(skill, sim, math.radians(100.0), strides=3, angle=math.radians(35.0))
-    assert made.outcome.success and made.stopped == "at the yaw" and made.strokes == len(skill.calls) <= 3
-    assert abs(wrap_angle(_yaw(sim) - math.radians(100.0))) <= YAW_WITHIN
-
-
-def test_spins_that_fall_short_ask_for_the_rest(sim):
-    skill = Turning(0.6)  # 60 % of each asked turn
-    made = spin_to(skill, sim, math.radians(70.0), strides=2, angle=math.radians(40.0))  # 24 + 27 + 11.4 deg
-    asked = [math.degrees(c[1]["angle"]) for c in skill.calls]
-    assert made.outcome.success and made.strokes == 3 == 2 + EXTRA_STROKES
-    assert asked[0] == pytest.approx(0.6 * 40.0) and asked[1] == pytest.approx(0.6 * 45.0)  # the rest, clipped
-
-
-def test_a_spin_that_does_not_turn_ends_the_call(sim):
-    made = spin_to(Turning(0.0), sim, math.radians(80.0), strides=2)
-    assert made.strokes == 1 and made.stopped == "did not turn" and not made.outcome.success
-    with pytest.raises(InputError):
-        spin_to(IdealSkill("push"), sim, 1.0, strides=2)
-    with pytest.raises(InputError):
-        spin_to(IdealSkill("spin"), sim, math.inf, strides=2)
