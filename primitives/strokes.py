@@ -18,9 +18,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
-from affordplan.checks import as_finite, as_whole
+from affordplan.checks import as_vector, as_whole
 from affordplan.errors import AffordplanError, InputError
 from affordplan.geometry import wrap_angle
 from primitives.params import made_progress
@@ -63,14 +61,10 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
     """
     if skill.name != "push":
         raise InputError(f"push_to takes the push skill, got {skill.name!r}")
-    target = np.array([as_finite("target x (m)", target_xy[0]), as_finite("target y (m)", target_xy[1])]) \
-        if len(target_xy) == 2 else None
-    if target is None:
-        raise InputError(f"target_xy must be (x, y) in metres, got {len(target_xy)} values")
+    target = as_vector("target_xy (m)", target_xy, 2)
     strides = as_whole("strides", strides, 1, 100)
     obj = sim.obj
-    T_first = sim.object_pose()
-    state, x0, y0, yaw0 = obj.planar_pose(T_first)
+    state, x0, y0, yaw0 = obj.planar_pose(sim.object_pose())
     heading0 = math.atan2(target[1] - y0, target[0] - x0)
     first, out, stopped, n = None, None, "strokes spent", 0
     for n in range(1, strides + EXTRA_STROKES + 1):
@@ -104,9 +98,8 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
         if math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN:
             stopped = "at the target"
             break
-    assert out is not None and first is not None  # the loop makes at least one stroke
+    assert out is not None and first is not None  # the loop makes at least one stroke (s1, x1, y1: its last)
     combined = copy.copy(out)
     combined.pose_before = first.pose_before
-    s1, x1, y1, _ = obj.planar_pose(out.pose_after)
     combined.success = bool(out.valid and s1 == state and math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN)
     return Strokes(combined, n, stopped)
