@@ -309,7 +309,8 @@ def test_bad_strides_are_refused(bad):
 
 
 def test_stuck_rates_fit_plans_with_strides():
-    models = {"push": _model("push"), "roll": _model("roll")}
-    plans = [[("push", 0.4, 0.0, 3), ("roll", 0.3)], [("push", 0.9, 0.0, 2)], [("roll", 0.2), ("push", 0.5)]]
-    rates, brier, bare = fit_stuck_rates(plans, [False, True, False], models, budget=10, n=200)
-    assert brier <= bare and set(rates) >= {"push", "roll"}
+    """A push of three strides is stuck per stride, as mc_odds draws it: at rate 1 and p 0.5 it gets through with
+    probability 0.5 ** 3, not 0.5."""
+    plans = [[("push", 0.5, 0.0, 3)]]
+    rates, brier, bare = fit_stuck_rates(plans, [False], {"push": Constant(1.0)}, budget=10, n=200, grid=(0.0, 1.0))
+    assert rates["push"] == 1.0 and bare == 1.0 and brier == pytest.approx(0.125 ** 2)
