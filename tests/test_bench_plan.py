@@ -130,6 +130,64 @@ def test_fit_stuck_fits_training_runs_only():
         fit_stuck([dict(objects="mixed", max_primitives=40, tasks=tasks)])
 
 
+def test_fit_stuck_reads_a_push_of_several_strides_as_its_odds_do():
+    """A saved plan's push of three strides stays a call of three strides in the fit (as ``Plan.odds`` reads it),
+    not one stride."""
+    from affordplan.app.bench.plan import fit_stuck
+    from planner.odds import mc_odds
+    from primitives.outcome_model import OutcomeModel
+
+    tasks = [dict(planner="affordplan", success=True, steps=[["push", 0.6, 0.0, 3]]) for _ in range(4)]
+    run = dict(objects="training", max_primitives=1, tasks=tasks)
+    fit = fit_stuck([run], held_out=[run], grid_step=0.5)
+    models = {"push": OutcomeModel.load("push")}
+    strided, single = (mc_odds(steps, models, 1, seed=0, stuck_rate=fit["rates"],
+                               tip_fatal=fit["tip_fatal"]).p_success
+                       for steps in ([("push", 0.6, 0.0, 3)], [("push", 0.6, 0.0)]))
+    assert abs(strided - single) > 0.05  # one call covering three strides, against one covering one
+    assert fit["held_out"]["brier"] == pytest.approx((1.0 - strided) ** 2)
+
+
+def _saved_run(seed: int, outcomes: list[bool], p: list[float], objects: str = "mixed") -> dict:
+    from dataclasses import asdict
+
+    from affordplan.app.bench.plan import BenchReport, TaskResult
+
+    results = [TaskResult("affordplan", "open", ok, 0.1 + 0.01 * i, 5 + i, 1, p_success=pi, task=i,
+                          steps=[("push", 0.5, 0.0, 2)]) for i, (ok, pi) in enumerate(zip(outcomes, p))]
+    results += [TaskResult("greedy", "open", not ok, 0.2, 20, 0, task=i) for i, ok in enumerate(outcomes)]
+    return BenchReport(results=results, objects=objects).as_dict()
+
+
+def test_pool_reports_over_the_tasks_of_every_run(tmp_path):
+    import json
+
+    from affordplan.app.bench.plan import plan_calibration, plot_report, pool
+
+    runs = [_saved_run(0, [True, False], [0.9, 0.2]), _saved_run(1, [True, True, False], [0.8, 0.7, 0.6])]
+    report = pool(json.loads(json.dumps(runs)))  # as read back from the saved files
+    s = report.summary("affordplan")
+    assert s["tasks"] == 5 and s["success"] == pytest.approx(3 / 5)
+    assert s["median_primitives"] == 6 and s["max_planning_time_s"] != s["max_planning_time_s"]  # nan: none saved
+    assert s["calibration"]["brier"] == pytest.approx(
+        plan_calibration([0.9, 0.2, 0.8, 0.7, 0.6], [True, False, True, True, False])["brier"])
+    assert report.summary("greedy")["success"] == pytest.approx(2 / 5)
+    assert report.results[0].steps == [("push", 0.5, 0.0, 2)]
+    plot_report(report, tmp_path / "bench.png")
+    assert (tmp_path / "bench.png").stat().st_size > 10_000
+
+
+def test_pool_refuses_runs_that_are_not_one_bench():
+    from affordplan.app.bench.plan import pool
+
+    with pytest.raises(InputError, match="differ"):
+        pool([_saved_run(0, [True], [0.5]), _saved_run(1, [True], [0.5], objects="household")])
+    with pytest.raises(InputError, match="not a saved"):
+        pool([dict(tasks=[])])
+    with pytest.raises(InputError, match="no bench runs"):
+        pool([])
+
+
 def test_the_bench_scores_a_plans_odds_within_the_budget_it_executes_with():
     """A plan's ``p_success`` is for the planner's 60 primitives; a bench run executing with 4 reports (and scores
     the calibration of) the odds within 4."""

@@ -89,6 +89,27 @@ def test_bench_plan_refuses_a_weights_folder_that_is_not_there_before_any_task(c
     assert "is not a folder" in captured.err and captured.out == ""
 
 
+def test_bench_pool_prints_one_report_over_saved_runs_and_refuses_a_bad_file(capsys, tmp_path):
+    import json
+
+    from affordplan.app.bench.plan import BenchReport, TaskResult
+
+    paths = []
+    for seed, ok in enumerate((True, False)):
+        run = BenchReport(results=[TaskResult("affordplan", "open", ok, 0.1, 4, 0, p_success=0.5, task=0)],
+                          objects="mixed").as_dict()
+        paths.append(tmp_path / f"bench_s{seed}.json")
+        paths[-1].write_text(json.dumps(run))
+    assert cli.main(["bench", "pool", *map(str, paths), "--plot", str(tmp_path / "b.png")]) == 0
+    out = capsys.readouterr().out
+    assert "2 runs pooled" in out and "Brier 0.250" in out and (tmp_path / "b.png").exists()
+    assert cli.main(["bench", "pool", str(paths[0]), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["summary"][0]["tasks"] == 1
+    (tmp_path / "bad.json").write_text("{not json")
+    assert cli.main(["bench", "pool", str(tmp_path / "bad.json")]) == 2
+    assert "cannot read bench results" in capsys.readouterr().err
+
+
 def test_cli_reports_library_errors_cleanly(capsys, tmp_path):
     assert cli.main(["render", "teapot"]) == 2
     assert "unknown object 'teapot'" in capsys.readouterr().err

@@ -155,21 +155,38 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_bench_fit_stuck(args: argparse.Namespace) -> int:
-    from affordplan.app.bench.plan import fit_stuck
+def _read_runs(paths: list[str]) -> list[dict]:
+    """Saved ``affordplan bench plan --json`` runs; an unreadable file raises InputError."""
     from affordplan.errors import InputError
 
-    def read(paths: list[str]) -> list[dict]:
-        reports = []
-        for path in paths:
-            try:
-                with open(path, encoding="utf-8") as f:
-                    reports.append(json.load(f))
-            except (OSError, ValueError) as exc:
-                raise InputError(f"cannot read bench results {str(path)[:120]}: {exc}") from None
-        return reports
+    reports = []
+    for path in paths:
+        try:
+            with open(path, encoding="utf-8") as f:
+                reports.append(json.load(f))
+        except (OSError, ValueError) as exc:
+            raise InputError(f"cannot read bench results {str(path)[:120]}: {exc}") from None
+    return reports
 
-    fit = fit_stuck(read(args.files), held_out=read(args.held_out or []))
+
+def _cmd_bench_pool(args: argparse.Namespace) -> int:
+    from affordplan.app.bench.plan import plot_report, pool
+
+    report = pool(_read_runs(args.files))
+    if args.plot:
+        plot_report(report, args.plot)
+    print(json.dumps(dict(runs=len(args.files), summary=[report.summary(n) for n in
+                                                          dict.fromkeys(r.planner for r in report.results)]),
+                     indent=2) if args.json else f"{len(args.files)} runs pooled\n" + report.report())
+    if args.plot and not args.json:
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def _cmd_bench_fit_stuck(args: argparse.Namespace) -> int:
+    from affordplan.app.bench.plan import fit_stuck
+
+    fit = fit_stuck(_read_runs(args.files), held_out=_read_runs(args.held_out or []))
     if args.json:
         print(json.dumps(fit, indent=2))
         return 0
@@ -533,6 +550,20 @@ def build_parser() -> argparse.ArgumentParser:
                     help="other runs, on any objects (scored, never fitted on), scored with the fitted rates")
     bf.add_argument("--json", action="store_true", help="print JSON instead of text")
     bf.set_defaults(func=_cmd_bench_fit_stuck)
+    bpo = bench_sub.add_parser(
+        "pool", help="one report over the tasks of several saved `bench plan --json` runs (e.g. eight seeds)",
+        formatter_class=_formatter,
+        description=_wrap("Pool saved plan-bench runs (the same budget, objects and draw) into one report: success, "
+                          "primitives per task, planning times, failures and the plan-level calibration over all "
+                          "their tasks, as `affordplan bench plan` reports one run."),
+        epilog="example:\n  for S in 0 1 2 3 4 5 6 7; do affordplan bench plan --tasks 50 --sim arm --objects mixed "
+               "--planner affordplan --seed $S --json > runs/bench_s$S.json; done\n"
+               "  affordplan bench pool runs/bench_s*.json --plot runs/bench.png")
+    bpo.add_argument("files", nargs="+", metavar="JSON", help="bench plan --json outputs")
+    bpo.add_argument("--plot", default=None, metavar="PNG",
+                     help="also draw primitives per task and the plan-level calibration to this image")
+    bpo.add_argument("--json", action="store_true", help="print JSON instead of text")
+    bpo.set_defaults(func=_cmd_bench_pool)
     _register_robustness(bench_sub)
     return parser
 

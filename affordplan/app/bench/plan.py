@@ -340,8 +340,9 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
 
 
 def _training_plans(reports: Sequence[dict], training: bool = True
-                    ) -> tuple[list[list[tuple[str, float, float]]], list[bool], int]:
-    """The affordplan first plans' steps (``(skill, p, tip)``; runs saved before tips were recorded give tip 0),
+                    ) -> tuple[list[list[tuple]], list[bool], int]:
+    """The affordplan first plans' steps as :func:`planner.odds.mc_odds` reads them (``(skill, p, tip)``, and
+    ``(skill, p, tip, strides)`` for a push of several strides; runs saved before tips were recorded give tip 0),
     whether each reached, and the runs' execution budget, from saved bench runs (on training objects, unless
     ``training`` is false)."""
     plans, reached, budgets = [], [], set()
@@ -353,7 +354,7 @@ def _training_plans(reports: Sequence[dict], training: bool = True
         for task in report["tasks"]:
             if task["planner"] == "affordplan" and task.get("steps"):
                 plans.append([(step[0], float(step[1]), float(step[2]) if len(step) > 2 else 0.0)
-                              for step in task["steps"]])
+                              + ((int(step[3]),) if len(step) > 3 else ()) for step in task["steps"]])
                 reached.append(bool(task["success"]))
     if not plans:
         raise InputError("no affordplan plans with steps in these runs")
@@ -395,3 +396,77 @@ def fit_stuck(reports: Sequence[dict], held_out: Sequence[dict] = (), grid_step:
                   for r, f in ((rates, fatal), (0.0, 0.0))]
         fit["held_out"] = dict(plans=len(plans), reached=float(y.mean()), brier=scores[0], brier_without=scores[1])
     return fit
+
+
+def pool(reports: Sequence[dict]) -> BenchReport:
+    """One :class:`BenchReport` of the tasks of several saved runs (``BenchReport.as_dict``, as ``affordplan bench
+    plan --json`` prints it), e.g. the eight seeds of the plan bench, so that its summary (success, primitives,
+    planning times, plan-level calibration) is over all of their tasks.
+
+    Raises:
+        InputError: no runs, a run that is not a saved plan bench, or runs that differ in their execution budget,
+            objects or draw (their tasks would not be one bench).
+    """
+    if not reports:
+        raise InputError("no bench runs to pool")
+    fields = {f for f in TaskResult.__dataclass_fields__}
+    kinds = set()
+    results = []
+    for i, report in enumerate(reports):
+        try:
+            kinds.add((int(report["max_primitives"]), str(report["objects"]), int(report.get("draw", 0))))
+            for task in report["tasks"]:
+                task = {k: v for k, v in task.items() if k in fields}
+                task["steps"] = [tuple(step) for step in task.get("steps", [])]
+                results.append(TaskResult(**task))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"run {i + 1} is not a saved `affordplan bench plan --json` run ({exc!r:.80})") from None
+    if len(kinds) != 1:
+        raise InputError("the runs differ in budget, objects or draw: "
+                         + "; ".join(f"budget {b}, objects {o}, draw {d}" for b, o, d in sorted(kinds)))
+    (budget, objects, draw), = kinds
+    return BenchReport(results=results, draw=draw, objects=objects, max_primitives=budget)
+
+
+def plot_report(report: BenchReport, path: str | os.PathLike) -> None:
+    """A picture of a bench report: each planner's primitives per task (reached and not), and the affordplan
+    plans' predicted ``p_success`` against how often they reached (plan-level calibration, 5 bins)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = list(dict.fromkeys(r.planner for r in report.results))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    top = max([r.primitives for r in report.results] + [report.max_primitives])
+    edges = np.arange(0, top + 3, 2) - 0.5
+    for name, colour in zip(names, ("#2b6cd9", "#888888", "#d98c2b")):
+        rs = [r for r in report.results if r.planner == name]
+        s = report.summary(name)
+        ax.hist([r.primitives for r in rs if r.success], bins=edges, histtype="step", color=colour, linewidth=1.5,
+                label=f"{name}: reached {s['success']:.2f}, median {s['median_primitives']:.0f}")
+        ax.hist([r.primitives for r in rs if not r.success], bins=edges, histtype="step", color=colour,
+                linestyle=":", label=f"{name}: not reached")
+    ax.axvline(report.max_primitives, color="black", linewidth=0.8)
+    ax.set_xlabel("primitives per task (the line: the budget)")
+    ax.set_ylabel("tasks")
+    ax.set_title(f"{len(report.results) // max(1, len(names))} tasks ({report.objects} objects)", fontsize=9)
+    ax.legend(fontsize=7)
+    cal = report.summary("affordplan").get("calibration") if "affordplan" in names else None
+    ax2.plot([0, 1], [0, 1], color="grey", linestyle="--", label="perfect calibration")
+    if cal and cal["plans"]:
+        centres = [b["predicted"] for b in cal["bins"]]
+        ax2.plot(centres, [b["reached"] for b in cal["bins"]], "o-", color="#2b6cd9", label="reached, per bin")
+        for b in cal["bins"]:
+            ax2.annotate(str(b["plans"]), (b["predicted"], b["reached"]), textcoords="offset points",
+                         xytext=(4, -10), fontsize=7)
+        ax2.set_title(f"affordplan plans: Brier {cal['brier']:.3f}, predicted {cal['mean_predicted']:.2f} vs "
+                      f"reached {cal['reached']:.2f}", fontsize=9)
+    ax2.set_xlim(0, 1)
+    ax2.set_ylim(0, 1)
+    ax2.set_xlabel("predicted p_success (bin mean; numbers: plans)")
+    ax2.set_ylabel("share reached")
+    ax2.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
