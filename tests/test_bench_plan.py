@@ -149,7 +149,6 @@ def test_fit_stuck_reads_a_push_of_several_strides_as_its_odds_do():
 
 
 def _saved_run(seed: int, outcomes: list[bool], p: list[float], objects: str = "mixed") -> dict:
-    from dataclasses import asdict
 
     from affordplan.app.bench.plan import BenchReport, TaskResult
 
