@@ -215,7 +215,7 @@ def test_a_rate_per_skill_applies_to_that_skills_steps_only():
 
 
 def test_the_shipped_stuck_rates_make_a_doubtful_roll_a_doubtful_plan():
-    """With the shipped rates (roll 0.8), a roll rated 0.5 leaves a plan about 1 - 0.8 * 0.5 = 0.6 to reach its goal
+    """With the shipped rates (roll 0.7), a roll rated 0.5 leaves a plan about 1 - 0.7 * 0.5 = 0.65 to reach its goal
     however large the budget; retries alone would promise it."""
     from planner.odds import STUCK_RATES
 
