@@ -155,7 +155,7 @@ def _saved_run(seed: int, outcomes: list[bool], p: list[float], objects: str = "
     results = [TaskResult("affordplan", "open", ok, 0.1 + 0.01 * i, 5 + i, 1, p_success=pi, task=i,
                           steps=[("push", 0.5, 0.0, 2)]) for i, (ok, pi) in enumerate(zip(outcomes, p))]
     results += [TaskResult("greedy", "open", not ok, 0.2, 20, 0, task=i) for i, ok in enumerate(outcomes)]
-    return BenchReport(results=results, objects=objects).as_dict()
+    return BenchReport(results=results, objects=objects, seed=seed).as_dict()
 
 
 def test_pool_reports_over_the_tasks_of_every_run(tmp_path):
@@ -181,6 +181,8 @@ def test_pool_refuses_runs_that_are_not_one_bench():
 
     with pytest.raises(InputError, match="differ"):
         pool([_saved_run(0, [True], [0.5]), _saved_run(1, [True], [0.5], objects="household")])
+    with pytest.raises(InputError, match="same seed"):
+        pool([_saved_run(3, [True], [0.5]), _saved_run(3, [False], [0.5])])
     with pytest.raises(InputError, match="not a saved"):
         pool([dict(tasks=[])])
     with pytest.raises(InputError, match="no bench runs"):

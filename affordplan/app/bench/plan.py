@@ -91,6 +91,7 @@ class BenchReport:
     draw: int = 0  # which draw of the run's random numbers (bench_plan's ``draw``)
     objects: str = "procedural"  # the tasks' objects (OBJECT_SETS)
     max_primitives: int = 40  # each execution's budget
+    seed: int | None = None  # the bench seed the tasks were drawn with (None: pooled from several)
 
     def summary(self, planner: str) -> dict:
         rs = [r for r in self.results if r.planner == planner]
@@ -146,8 +147,8 @@ class BenchReport:
 
     def as_dict(self) -> dict:
         names = list(dict.fromkeys(r.planner for r in self.results))
-        return dict(versions=versions(), draw=self.draw, objects=self.objects, max_primitives=self.max_primitives,
-                    summary=[self.summary(n) for n in names],
+        return dict(versions=versions(), seed=self.seed, draw=self.draw, objects=self.objects,
+                    max_primitives=self.max_primitives, summary=[self.summary(n) for n in names],
                     tasks=[asdict(r) for r in self.results])
 
 
@@ -319,7 +320,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
         raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
     skills = None if weights_dir is None else load_skills(weights_dir)
     rng = np.random.default_rng(seed)
-    report = BenchReport(draw=draw, objects=objects, max_primitives=max_primitives)
+    report = BenchReport(draw=draw, objects=objects, max_primitives=max_primitives, seed=seed)
     bar = tqdm(total=len(wanted), desc=f"bench plan ({sim})", disable=not progress, unit="task")
     for i in range(max(wanted) + 1):
         # drawn in order: task i is the same in any run
@@ -404,19 +405,21 @@ def pool(reports: Sequence[dict]) -> BenchReport:
     planning times, plan-level calibration) is over all of their tasks.
 
     Raises:
-        InputError: no runs, a run that is not a saved plan bench, or runs that differ in their execution budget,
-            objects or draw (their tasks would not be one bench).
+        InputError: no runs, a run that is not a saved plan bench, runs that differ in their execution budget,
+            objects or draw (their tasks would not be one bench), or two runs of one seed.
     """
     if not reports:
         raise InputError("no bench runs to pool")
-    fields = {f for f in TaskResult.__dataclass_fields__}
-    kinds = set()
+    known = set(TaskResult.__dataclass_fields__)
+    kinds, seeds = set(), []
     results = []
     for i, report in enumerate(reports):
         try:
             kinds.add((int(report["max_primitives"]), str(report["objects"]), int(report.get("draw", 0))))
+            if report.get("seed") is not None:  # runs saved before 0.24 carry no seed
+                seeds.append(int(report["seed"]))
             for task in report["tasks"]:
-                task = {k: v for k, v in task.items() if k in fields}
+                task = {k: v for k, v in task.items() if k in known}
                 task["steps"] = [tuple(step) for step in task.get("steps", [])]
                 results.append(TaskResult(**task))
         except (KeyError, TypeError, ValueError) as exc:
@@ -424,6 +427,9 @@ def pool(reports: Sequence[dict]) -> BenchReport:
     if len(kinds) != 1:
         raise InputError("the runs differ in budget, objects or draw: "
                          + "; ".join(f"budget {b}, objects {o}, draw {d}" for b, o, d in sorted(kinds)))
+    twice = sorted({s for s in seeds if seeds.count(s) > 1})
+    if twice:
+        raise InputError(f"runs of the same seed given twice: {twice}")
     (budget, objects, draw), = kinds
     return BenchReport(results=results, draw=draw, objects=objects, max_primitives=budget)
 
