@@ -175,9 +175,8 @@ def _cmd_bench_pool(args: argparse.Namespace) -> int:
     report = pool(_read_runs(args.files))
     if args.plot:
         plot_report(report, args.plot)
-    print(json.dumps(dict(runs=len(args.files), summary=[report.summary(n) for n in
-                                                          dict.fromkeys(r.planner for r in report.results)]),
-                     indent=2) if args.json else f"{len(args.files)} runs pooled\n" + report.report())
+    print(json.dumps(dict(runs=len(args.files), summary=[report.summary(n) for n in report.planners]), indent=2)
+          if args.json else f"{len(args.files)} runs pooled\n" + report.report())
     if args.plot and not args.json:
         print(f"wrote {args.plot}")
     return 0

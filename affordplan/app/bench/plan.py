@@ -93,6 +93,11 @@ class BenchReport:
     max_primitives: int = 40  # each execution's budget
     seed: int | None = None  # the bench seed the tasks were drawn with (None: pooled from several)
 
+    @property
+    def planners(self) -> list[str]:
+        """The planners of the results, in the order they first ran."""
+        return list(dict.fromkeys(r.planner for r in self.results))
+
     def summary(self, planner: str) -> dict:
         rs = [r for r in self.results if r.planner == planner]
         if not rs:
@@ -120,7 +125,7 @@ class BenchReport:
                  f"{'planner':10s} {'tasks':>5s} {'success':>8s} {'plan time (median / max)':>25s} "
                  f"{'primitives (mean / median / p90)':>33s} {'replans/task':>13s}  by scene; goal state rarer "
                  f"than {RARE_GOAL_STATE:.0%} of drops"]
-        summaries = [self.summary(name) for name in dict.fromkeys(r.planner for r in self.results)]
+        summaries = [self.summary(name) for name in self.planners]
         for s in summaries:
             scenes = ", ".join(f"{k} {v:.2f}" for k, v in s["success_by_scene"].items())
             rare = s["rare_goal_states"]
@@ -146,9 +151,8 @@ class BenchReport:
         return "\n".join(lines)
 
     def as_dict(self) -> dict:
-        names = list(dict.fromkeys(r.planner for r in self.results))
         return dict(versions=versions(), seed=self.seed, draw=self.draw, objects=self.objects,
-                    max_primitives=self.max_primitives, summary=[self.summary(n) for n in names],
+                    max_primitives=self.max_primitives, summary=[self.summary(n) for n in self.planners],
                     tasks=[asdict(r) for r in self.results])
 
 
@@ -442,13 +446,12 @@ def plot_report(report: BenchReport, path: str | os.PathLike) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = list(dict.fromkeys(r.planner for r in report.results))
+    summaries = {name: report.summary(name) for name in report.planners}
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     top = max([r.primitives for r in report.results] + [report.max_primitives])
     edges = np.arange(0, top + 3, 2) - 0.5
-    for name, colour in zip(names, ("#2b6cd9", "#888888", "#d98c2b")):
+    for (name, s), colour in zip(summaries.items(), ("#2b6cd9", "#888888", "#d98c2b")):
         rs = [r for r in report.results if r.planner == name]
-        s = report.summary(name)
         ax.hist([r.primitives for r in rs if r.success], bins=edges, histtype="step", color=colour, linewidth=1.5,
                 label=f"{name}: reached {s['success']:.2f}, median {s['median_primitives']:.0f}")
         ax.hist([r.primitives for r in rs if not r.success], bins=edges, histtype="step", color=colour,
@@ -456,9 +459,9 @@ def plot_report(report: BenchReport, path: str | os.PathLike) -> None:
     ax.axvline(report.max_primitives, color="black", linewidth=0.8)
     ax.set_xlabel("primitives per task (the line: the budget)")
     ax.set_ylabel("tasks")
-    ax.set_title(f"{len(report.results) // max(1, len(names))} tasks ({report.objects} objects)", fontsize=9)
+    ax.set_title(f"{len(report.results) // max(1, len(summaries))} tasks ({report.objects} objects)", fontsize=9)
     ax.legend(fontsize=7)
-    cal = report.summary("affordplan").get("calibration") if "affordplan" in names else None
+    cal = summaries["affordplan"]["calibration"] if "affordplan" in summaries else None
     ax2.plot([0, 1], [0, 1], color="grey", linestyle="--", label="perfect calibration")
     if cal and cal["plans"]:
         centres = [b["predicted"] for b in cal["bins"]]
