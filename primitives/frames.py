@@ -51,6 +51,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+import torch
 from scipy.special import expit, logit
 
 from affordplan.checks import is_whole, require_whole
@@ -58,10 +59,13 @@ from affordplan.errors import InputError
 from affordplan.geometry import rot_z
 from primitives import params as skill_params
 from primitives.observation import OBS_DIM, SkillObservation, observe_cloud
+from primitives.option_ranker import OptionRanker, cloud_extents, load_ranker, option_features, request_size
+from primitives.success_model import decision_features
 from primitives.weights_file import rating_path
 
 if TYPE_CHECKING:
     from affordplan.sim import Simulator
+    from primitives.networks import HybridActorCritic
 
 MIRROR_Y = np.diag([1.0, -1.0, 1.0])
 
@@ -136,7 +140,9 @@ class FrameSearch:
     stand-in requests (:func:`stand_in_requests`; push: that many directions, a multiple of ``turns`` so that
     the set tried is the same from every frame; spin, roll: any number > 0; 0: none), and calibrate the chosen
     score with ``platt_stand_ins`` instead of ``platt_unparameterised``. ``info``: how the calibration was made
-    (command, figures).
+    (command, figures). ``ranker``: an :class:`~primitives.option_ranker.OptionRanker` that picks the option to
+    act in instead of the ratings (:meth:`choose`), loaded from the file ``ranker_file`` names beside the JSON
+    file (:meth:`load`); ``None``: the ratings pick.
     """
 
     turns: int = 1
@@ -146,9 +152,13 @@ class FrameSearch:
     info: dict = field(default_factory=dict, compare=False)
     stand_ins: int = 0
     platt_stand_ins: tuple[float, float] = (1.0, 0.0)
+    ranker_file: str = ""
+    ranker: OptionRanker | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
         free_frames("spin", None, self.turns, self.mirror)  # checks turns
+        if bool(self.ranker_file) != (self.ranker is not None):
+            raise InputError("a FrameSearch names a ranker file exactly when it carries a ranker")
         if not is_whole(self.stand_ins) or self.stand_ins < 0 or (self.stand_ins and self.stand_ins % self.turns):
             raise InputError(f"stand_ins must be 0 or a whole multiple of turns ({self.turns}), got {self.stand_ins!r}")
         for ab in (self.platt, self.platt_unparameterised, self.platt_stand_ins):
@@ -187,11 +197,36 @@ class FrameSearch:
         p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
         return np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
 
-    def choose(self, options: list[tuple[SkillObservation, np.ndarray]],
-               ratings: list[np.ndarray]) -> tuple[int, int, float]:
+    def rank(self, skill: str, options: list[tuple[SkillObservation, np.ndarray]], ratings: list[np.ndarray],
+             policy: HybridActorCritic) -> list[np.ndarray]:
+        """This search's ranker's P(success) of each option's frames (split as ``ratings``), from ``policy``'s
+        decision in each (:mod:`primitives.option_ranker`). Raises :class:`InputError` without a ranker."""
+        if self.ranker is None:
+            raise InputError("this frame search has no option ranker")
+        obs = np.concatenate([reframe_obs(o.obs, f) for o, f in options])
+        with torch.no_grad():
+            _, _, decision = decision_features(policy, torch.from_numpy(obs))
+        kinds = [(o.params, k > 0) for k, (o, f) in enumerate(options) for _ in range(len(f))]
+        features = option_features(decision.numpy(), np.concatenate(ratings),
+                                   np.array([request_size(skill, p) for p, _ in kinds]),
+                                   np.array([p is not None for p, _ in kinds]), np.array([s for _, s in kinds]),
+                                   cloud_extents(options[0][0].obs[:, :3]))
+        p = self.ranker.score(features)
+        return np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
+
+    def choose(self, options: list[tuple[SkillObservation, np.ndarray]], ratings: list[np.ndarray],
+               ranking: list[np.ndarray] | None = None) -> tuple[int, int, float]:
         """The option and frame to act in, ``(k, j)``, given each option's ratings (one per frame), and its score:
         the best raw rating of the one option, or among several the option whose best rating, calibrated for its
-        kind, is highest (module docstring), and that calibrated rating."""
+        kind, is highest (module docstring), and that calibrated rating.
+
+        ``ranking`` (:meth:`rank`, split as ``ratings``): act in the frame it ranks highest instead; the score is
+        still that frame's rating, raw for one option or calibrated for its kind among several."""
+        if ranking is not None:
+            k = int(np.argmax([q.max() for q in ranking]))
+            j = int(np.argmax(ranking[k]))
+            p = float(ratings[k][j])
+            return k, j, p if len(options) == 1 else float(self.calibrate_kind(p, options[k][0].params is not None))
         best = [int(np.argmax(q)) for q in ratings]
         if len(options) == 1:
             return 0, best[0], float(ratings[0][best[0]])
@@ -209,7 +244,8 @@ class FrameSearch:
         chosen = reframe(option, frames[j])
         return replace(chosen, params=None, acted_as=option.params) if k else chosen
 
-    def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator) -> tuple[SkillObservation, float]:
+    def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator,
+               policy: HybridActorCritic | None = None) -> tuple[SkillObservation, float]:
         """The observation to act on and its score: ``seen`` (of ``sim``'s current cloud) in the free frame, or
         for the seed's objective with stand-ins the free frame of the stand-in request, that ``predict``
         (observations ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch
@@ -218,7 +254,17 @@ class FrameSearch:
         The returned observation keeps ``seen.params`` (what the outcome is judged by); ``acted_as`` names the
         stand-in request where one was chosen. The score is the best raw rating, or with stand-ins the best rating
         calibrated for its kind (module docstring); :meth:`calibrate` it with ``seen.params is not None``.
+
+        With a ranker, ``policy`` (the skill's) is required: the ranker picks from its decision in each option
+        (:meth:`rank`).
         """
+        if self.ranker is not None:
+            if policy is None:
+                raise InputError("a frame search with an option ranker needs the skill's policy to select")
+            options = self.options(skill, seen, sim)
+            ratings = self.rate(options, predict)
+            k, j, score = self.choose(options, ratings, self.rank(skill, options, ratings, policy))
+            return self.acting(options, k, j), score
         if not self.tries_stand_ins(seen.params):
             return select_frame(seen, predict, self.frames(skill, seen.params))
         options = self.options(skill, seen, sim)
@@ -241,9 +287,13 @@ class FrameSearch:
         return np.where(parameterised, self.calibrate_kind(p, True), expit(a * rating_logit(p) + b))
 
     def save(self, path: str | os.PathLike) -> None:
-        d = asdict(self)
+        """Write this search as JSON (a ranker is not written: ``ranker_file`` names its file beside ``path``)."""
+        d = asdict(replace(self, ranker=None, ranker_file=""))
         for key in ("platt", "platt_unparameterised", "platt_stand_ins"):
             d[key] = list(d[key])
+        del d["ranker"], d["ranker_file"]
+        if self.ranker_file:
+            d["ranker"] = self.ranker_file
         Path(path).write_text(json.dumps(d, indent=2) + "\n")
 
     @classmethod
@@ -251,11 +301,18 @@ class FrameSearch:
         """A frame search from a JSON file (raises :class:`InputError` for an unreadable one)."""
         try:
             d = json.loads(Path(path).read_text())
-            return cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
-                       tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}),
-                       int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))))
+            ranker_file = str(d.get("ranker", ""))
+            search = cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
+                         tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}),
+                         int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
+        if not ranker_file:
+            return search
+        if Path(ranker_file).name != ranker_file:
+            raise InputError(f"frame search file {path} names its ranker {ranker_file!r}; it must be a file name "
+                             f"beside it")
+        return replace(search, ranker_file=ranker_file, ranker=load_ranker(Path(path).parent / ranker_file))
 
 
 def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None,

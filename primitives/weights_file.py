@@ -36,8 +36,9 @@ from primitives.params import SKILLS
 
 FORMAT = "affordplan-weights"
 FORMAT_VERSION = 1
-KINDS = ("policy", "success", "checkpoint")
-_WHAT = {"policy": "weights", "success": "success model", "checkpoint": "checkpoint"}  # for messages
+KINDS = ("policy", "success", "checkpoint", "ranker")
+# for messages
+_WHAT = {"policy": "weights", "success": "success model", "checkpoint": "checkpoint", "ranker": "option ranker"}
 SHIPPED_DIR = Path(__file__).parent / "weights"  # the shipped weights: the one place that knows where they live
 
 

@@ -56,8 +56,9 @@ class StartOptions:
     """Every option of one start, in the order :meth:`FrameSearch.options` lists them (the goal frame first).
 
     ``option``: the option each row belongs to (0: the request itself, ``k > 0``: the k-th stand-in); ``frame``:
-    its frame's index in that option; ``rating``: the success model's rating calibrated for its kind
-    (:meth:`FrameSearch.calibrate_kind`); ``q_max``: the critic's value at the policy's contact; ``success``: the
+    its frame's index in that option; ``rating``: what the search compares options on, the success model's rating
+    calibrated for its kind (:meth:`FrameSearch.calibrate_kind`) or, for a search with an option ranker, the
+    ranker's probability; ``q_max``: the critic's value at the policy's contact; ``success``: the
     outcome of executing it from the start; ``pick``: the row the search acts in.
     """
 
@@ -146,7 +147,8 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     start = sim.snapshot()
     options = search.options(skill, seen, sim)
     ratings = search.rate(options, predict)
-    k_pick, j_pick, _ = search.choose(options, ratings)
+    ranking = search.rank(skill, options, ratings, policy) if search.ranker is not None else None
+    k_pick, j_pick, _ = search.choose(options, ratings, ranking)
     option, frame, q_max, success = [], [], [], []
     for k, (_, frames) in enumerate(options):
         for j in range(len(frames)):
@@ -160,7 +162,9 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     option, frame = np.array(option), np.array(frame)
     parameterised = np.array([options[k][0].params is not None for k in option])
     pick = int(np.flatnonzero((option == k_pick) & (frame == j_pick))[0])
-    return StartOptions(seen.params, option, frame, search.calibrate_kind(np.concatenate(ratings), parameterised),
+    compared = (np.concatenate(ranking) if ranking is not None
+                else search.calibrate_kind(np.concatenate(ratings), parameterised))
+    return StartOptions(seen.params, option, frame, compared,
                         np.array(q_max), np.array(success, dtype=bool), pick)
 
 

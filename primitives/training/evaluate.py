@@ -154,7 +154,7 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
         obs = env.reset(object_key=key)
         if predict is not None:
             params = env.seen.params
-            env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim)
+            env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim, policy=model)
             obs = env.seen.obs
             if frame_search.searches(primitive, params):
                 result.frames = (f"best of {len(frame_search.frames(primitive, params))} free frames"

@@ -1,0 +1,278 @@
+"""Fitting a frame search's option ranker: every option of training starts executed, then a small MLP.
+
+    python -m primitives.training.ranker collect spin --starts 400 --params none --out runs/spin_opts_none
+    python -m primitives.training.ranker collect spin --starts 800 --params random --out runs/spin_opts_random
+    python -m primitives.training.ranker fit spin runs/spin_opts_none runs/spin_opts_random --out runs/spin_ranker.pt
+
+**collect** draws stable starts of training objects (``--objects``, never held-out ones) and, for each, executes
+the policy in *every* option the frame search rates (each free frame of the request and of each stand-in request,
+:meth:`primitives.frames.FrameSearch.options`), restoring the simulator to the start before each. It records per
+option what the ranker reads (:func:`primitives.option_ranker.option_features`' inputs) and whether it succeeded.
+Starts come in chunks of ``--chunk``, each from an environment seeded by ``(seed, chunk)`` and written to its own
+``chunk_NNNN.npz`` when done: a collection killed at any moment resumes at its first missing chunk, and gives the
+same data as one never stopped.
+
+**fit** trains :class:`primitives.option_ranker.OptionRanker` with a binary cross-entropy on the options of the
+collected starts, a fifth of the starts (drawn with ``--seed``) held out; it keeps the epoch whose held-out
+*pick* (the success of the option it would act in, averaged over the held-out starts) is highest, and reports that
+pick beside the success model's pick, the best option and an option at random. The training is a few minutes of one
+core; nothing of it is checkpointed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import nn
+from tqdm import tqdm
+
+from affordplan.errors import AffordplanError, InputError
+from affordplan.log import cli_logging
+from affordplan.sim.sensor import SENSORS
+from primitives.frames import FrameSearch, load_frame_search
+from primitives.option_ranker import (
+    OptionRanker,
+    cloud_extents,
+    option_features,
+    request_size,
+    save_ranker,
+)
+from primitives.success_model import decision_features
+from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
+from primitives.training.evaluate import load_policy
+from primitives.training.success import SuccessModel, auroc, load_success_net
+
+COLUMNS = ("start", "decision", "rating", "request", "parameterised", "stand_in", "extents", "success", "chosen")
+
+
+def start_rows(env: PrimitiveEnv, model: SuccessModel, search: FrameSearch) -> dict[str, np.ndarray]:
+    """Every option of ``env``'s current start executed from it (the start restored before each and after the
+    last): the per-option columns of :data:`COLUMNS` but ``start``. ``chosen`` marks the option the search without
+    a ranker acts in."""
+    skill, sim, seen = env.config.primitive, env.sim, env.seen
+    start = sim.snapshot()
+    options = search.options(skill, seen, sim)
+    ratings = search.rate(options, model.predict)
+    k_pick, j_pick, _ = search.choose(options, ratings)
+    acting = [(k, j, search.acting(options, k, j)) for k, (_, frames) in enumerate(options)
+              for j in range(len(frames))]
+    with torch.no_grad():
+        index, motion, decision = decision_features(model.policy, torch.from_numpy(
+            np.stack([a.obs for _, _, a in acting]).astype(np.float32)))
+    success = []
+    for n, (_, _, a) in enumerate(acting):
+        sim.restore(start)
+        env.seen = a
+        success.append(env.step(int(index[n]), motion[n].numpy().astype(np.float64)).success)
+    sim.restore(start)
+    env.seen = seen
+    m = len(acting)
+    return dict(decision=decision.numpy(), rating=np.concatenate(ratings),
+                request=np.array([request_size(skill, options[k][0].params) for k, _, _ in acting]),
+                parameterised=np.array([options[k][0].params is not None for k, _, _ in acting]),
+                stand_in=np.array([k > 0 for k, _, _ in acting]),
+                extents=np.tile(cloud_extents(seen.obs[:, :3]), (m, 1)),
+                success=np.array(success, dtype=bool),
+                chosen=np.array([(k, j) == (k_pick, j_pick) for k, j, _ in acting]))
+
+
+def collect(skill: str, out: str | Path, starts: int, params: str = "none", objects: str = "train+housekeep:training",
+            sensor: str = "cameras", seed: int = 0, chunk: int = 25, progress: bool = True) -> Path:
+    """Collect ``starts`` starts (module docstring) into the folder ``out``; returns it. ``params``: ``"none"``
+    (the seed's objective) or ``"random"`` (a random request each start)."""
+    if starts < 1 or chunk < 1:
+        raise InputError(f"--starts and --chunk must be positive whole numbers, got {starts} and {chunk}")
+    if params not in ("none", "random"):
+        raise InputError(f"--params must be none or random, got {params!r}")
+    check_objects(objects, fitting=True)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    policy = load_policy(None, skill)
+    model = SuccessModel(policy, load_success_net(skill, None, sensor))
+    search = load_frame_search(skill, "shipped", sensor)
+    config = EnvConfig(skill, objects=objects, episodes_per_object=1, p_params=1.0 if params == "random" else 0.0,
+                       sensor=sensor)
+    n_chunks = -(-starts // chunk)
+    done = sum(chunk for c in range(n_chunks) if (out / f"chunk_{c:04d}.npz").exists())
+    bar = tqdm(total=starts, initial=min(done, starts), desc=f"{skill} options", unit="start", disable=not progress,
+               mininterval=2.0)
+    for c in range(n_chunks):
+        path = out / f"chunk_{c:04d}.npz"
+        if path.exists():
+            continue
+        env = PrimitiveEnv(config, seed=int(np.random.SeedSequence([seed, c]).generate_state(1)[0]))
+        rows: dict[str, list] = {key: [] for key in COLUMNS}
+        for s in range(c * chunk, min((c + 1) * chunk, starts)):
+            env.reset()
+            got = start_rows(env, model, search)
+            for key, value in got.items():
+                rows[key].append(value)
+            rows["start"].append(np.full(len(got["success"]), s))
+            bar.update(1)
+        env.close()
+        tmp = path.with_suffix(".tmp.npz")
+        np.savez(tmp, **{key: np.concatenate(v) for key, v in rows.items()},
+                 meta=np.array(json.dumps(dict(skill=skill, params=params, objects=objects, sensor=sensor,
+                                               seed=seed, chunk=chunk))))
+        tmp.replace(path)
+    bar.close()
+    return out
+
+
+def read_collections(skill: str, folders: list[str | Path]) -> tuple[dict[str, np.ndarray], str]:
+    """The rows of every chunk in ``folders`` (each start numbered apart across folders) and their sensor.
+
+    Raises:
+        InputError: a folder without chunks, chunks of another skill, or of different sensors.
+    """
+    rows: dict[str, list] = {key: [] for key in COLUMNS}
+    sensors, offset = set(), 0
+    for folder in folders:
+        chunks = sorted(Path(folder).glob("chunk_*.npz"))
+        if not chunks:
+            raise InputError(f"{folder}: no collected chunks (chunk_NNNN.npz) there")
+        for path in chunks:
+            with np.load(path) as d:
+                meta = json.loads(str(d["meta"]))
+                if meta["skill"] != skill:
+                    raise InputError(f"{path} holds {meta['skill']} options, not {skill}")
+                sensors.add(meta["sensor"])
+                for key in COLUMNS:
+                    rows[key].append(d[key] + offset if key == "start" else d[key])
+        offset = int(max(r.max() for r in rows["start"])) + 1
+    if len(sensors) != 1:
+        raise InputError(f"the collections mix sensors ({', '.join(sorted(sensors))}); fit one ranker per sensor")
+    return {key: np.concatenate(v) for key, v in rows.items()}, sensors.pop()
+
+
+def features_of(rows: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(features, success, start)`` of collected rows, the features made start by start
+    (:func:`option_features`)."""
+    starts = rows["start"]
+    features = np.zeros((len(starts), 2 * (rows["decision"].shape[1] + 7)), dtype=np.float32)
+    for s in np.unique(starts):
+        m = starts == s
+        features[m] = option_features(rows["decision"][m], rows["rating"][m], rows["request"][m],
+                                      rows["parameterised"][m], rows["stand_in"][m], rows["extents"][m][0])
+    return features, rows["success"].astype(np.float32), starts
+
+
+def pick_figures(score: np.ndarray, success: np.ndarray, starts: np.ndarray) -> dict[str, float]:
+    """Over the starts: the success of the option ``score`` ranks highest (``pick``), of the best and of a random
+    option, and the within-start AUROC of ``score`` over the starts whose options both succeed and fail."""
+    picks, best, rand, aucs = [], [], [], []
+    for s in np.unique(starts):
+        m = starts == s
+        y, p = success[m], score[m]
+        picks.append(y[int(np.argmax(p))]), best.append(y.max()), rand.append(y.mean())
+        if 0 < y.sum() < len(y):
+            aucs.append(auroc(p, y.astype(bool)))
+    return dict(starts=len(picks), pick=float(np.mean(picks)), best=float(np.mean(best)),
+                random=float(np.mean(rand)), within_start_auroc=float(np.mean(aucs)) if aucs else float("nan"))
+
+
+def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, epochs: int = 40, width: int = 64,
+        weight_decay: float = 1e-4, progress: bool = True) -> dict:
+    """Fit and save an option ranker on collected options (module docstring); returns what it printed."""
+    t0 = time.perf_counter()
+    rows, sensor = read_collections(skill, folders)
+    x, y, starts = features_of(rows)
+    rng = np.random.default_rng(seed)
+    ids = np.unique(starts)
+    held = np.isin(starts, rng.choice(ids, size=max(1, len(ids) // 5), replace=False))
+    torch.manual_seed(seed)
+    ranker = OptionRanker(width)
+    ranker.mean.copy_(torch.from_numpy(x[~held].mean(axis=0)))
+    ranker.scale.copy_(torch.from_numpy(x[~held].std(axis=0) + 1e-6))
+    xt, yt = torch.from_numpy(x[~held]), torch.from_numpy(y[~held])
+    opt = torch.optim.AdamW(ranker.parameters(), lr=1e-3, weight_decay=weight_decay)
+    loss_fn = nn.BCEWithLogitsLoss()
+    best_pick, best_state, best_epoch = -1.0, None, 0
+    for epoch in tqdm(range(epochs), desc=f"{skill} ranker", disable=not progress):
+        ranker.train()
+        for batch in torch.randperm(len(xt)).split(256):
+            opt.zero_grad()
+            loss_fn(ranker(xt[batch]), yt[batch]).backward()
+            opt.step()
+        ranker.eval()
+        pick = pick_figures(ranker.score(x[held]), y[held], starts[held])["pick"]
+        if pick > best_pick:
+            best_pick, best_epoch = pick, epoch + 1
+            best_state = {k: v.clone() for k, v in ranker.state_dict().items()}
+    ranker.load_state_dict(best_state)
+    ranker.eval()
+    figures = dict(held_out=pick_figures(ranker.score(x[held]), y[held], starts[held]),
+                   ratings_held_out=pick_figures(rows["rating"][held], y[held], starts[held]),
+                   search_pick_held_out=float(np.mean([rows["success"][held & (starts == s) & rows["chosen"]].any()
+                                                       for s in np.unique(starts[held])])),
+                   train=pick_figures(ranker.score(x[~held]), y[~held], starts[~held]))
+    info = dict(command=" ".join(["python -m primitives.training.ranker fit", skill, *map(str, folders), "--out",
+                                  str(out), "--seed", str(seed), "--epochs", str(epochs), "--width", str(width)]),
+                starts=int(len(ids)), options=int(len(y)), epoch=best_epoch, sensor=sensor,
+                minutes=round((time.perf_counter() - t0) / 60.0, 2), **figures)
+    save_ranker(out, ranker, skill, sensor, info)
+    return info
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m primitives.training.ranker", description=__doc__.split("\n\n")[0],
+                                epilog="\n".join(__doc__.split("\n\n")[1].splitlines()),
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    c = sub.add_parser("collect", help="execute every option of training starts")
+    c.add_argument("skill", choices=PRIMITIVES)
+    c.add_argument("--starts", type=int, default=400, help="starts (default: 400)")
+    c.add_argument("--params", choices=["none", "random"], default="none",
+                   help="none: the seed's objective; random: a random request each start (default: none)")
+    c.add_argument("--objects", default="train+housekeep:training",
+                   help="training objects (default: train+housekeep:training)")
+    c.add_argument("--sensor", choices=SENSORS, default="cameras", help="the clouds seen (default: cameras)")
+    c.add_argument("--seed", type=int, default=0)
+    c.add_argument("--chunk", type=int, default=25, help="starts per saved chunk (default: 25)")
+    c.add_argument("--out", required=True, help="folder of the chunks (resumed where it holds some)")
+    f = sub.add_parser("fit", help="fit an option ranker on collected options")
+    f.add_argument("skill", choices=PRIMITIVES)
+    f.add_argument("folders", nargs="+", help="collect's --out folders")
+    f.add_argument("--out", required=True, help="the ranker file to write")
+    f.add_argument("--seed", type=int, default=0)
+    f.add_argument("--epochs", type=int, default=40)
+    f.add_argument("--width", type=int, default=64)
+    f.add_argument("--json", action="store_true")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    cli_logging()
+    torch.set_num_threads(1)
+    try:
+        if args.command == "collect":
+            out = collect(args.skill, args.out, args.starts, args.params, args.objects, args.sensor, args.seed,
+                          args.chunk)
+            print(f"collected {args.starts} starts of {args.skill} into {out}")
+            return 0
+        info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, progress=not args.json)
+    except AffordplanError as exc:
+        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
+        return 2
+    if args.json:
+        print(json.dumps(info, indent=2))
+    else:
+        h, r = info["held_out"], info["ratings_held_out"]
+        print(f"{args.skill} ranker -> {args.out}: {info['starts']} starts, {info['options']} options, epoch "
+              f"{info['epoch']}\n  held-out starts: ranker's pick {h['pick']:.3f} (within-start AUROC "
+              f"{h['within_start_auroc']:.3f}); the search's pick {info['search_pick_held_out']:.3f}; the ratings' "
+              f"best {r['pick']:.3f} ({r['within_start_auroc']:.3f}); best option {h['best']:.3f}, random "
+              f"{h['random']:.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
