@@ -3,6 +3,7 @@
     python -m primitives.training.ranker collect spin --starts 400 --params none --out runs/spin_opts_none
     python -m primitives.training.ranker collect spin --starts 800 --params random --out runs/spin_opts_random
     python -m primitives.training.ranker fit spin runs/spin_opts_none runs/spin_opts_random --out runs/spin_ranker.pt
+    python -m primitives.training.ranker attach spin --ranker runs/spin_ranker.pt --out candidates/spin_ranked
 
 **collect** draws stable starts of training objects (``--objects``, never held-out ones) and, for each, executes
 the policy in *every* option the frame search rates (each free frame of the request and of each stand-in request,
@@ -17,14 +18,20 @@ collected starts, a fifth of the starts (drawn with ``--seed``) held out; it kee
 *pick* (the success of the option it would act in, averaged over the held-out starts) is highest, and reports that
 pick beside the success model's pick, the best option and an option at random. The training is a few minutes of one
 core; nothing of it is checkpointed.
+
+**attach** writes a frame search that acts on a ranker: the shipped frame search for ``--sensor`` (or ``--frames``)
+with the ranker's file named in it, both into the folder ``--out`` (``{skill}_frames.json``, ``{skill}_ranker.pt``),
+ready for ``--frames`` of the evaluation commands or for ``weights/{sensor}/``.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +46,7 @@ from primitives.frames import FrameSearch, load_frame_search
 from primitives.option_ranker import (
     OptionRanker,
     cloud_extents,
+    load_ranker,
     option_features,
     request_size,
     save_ranker,
@@ -220,6 +228,22 @@ def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, e
     return info
 
 
+def attach(skill: str, ranker: str | Path, out: str | Path, frames: str = "shipped",
+           sensor: str = "cameras") -> Path:
+    """Write ``frames`` (``"shipped"``: the shipped frame search for ``sensor``'s clouds, or a frames.json path)
+    acting on ``ranker`` into the folder ``out`` (module docstring); returns the frames file written."""
+    load_ranker(ranker, skill)  # refuses a file that is not a ranker for skill before anything is written
+    search = load_frame_search(skill, frames, sensor)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    name = f"{skill}_ranker.pt"
+    if Path(ranker).resolve() != (out / name).resolve():
+        shutil.copyfile(ranker, out / name)
+    path = out / f"{skill}_frames.json"
+    replace(search, ranker_file=name, ranker=load_ranker(out / name, skill)).save(path)
+    return path
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m primitives.training.ranker", description=__doc__.split("\n\n")[0],
                                 epilog="\n".join(__doc__.split("\n\n")[1].splitlines()),
@@ -244,6 +268,13 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--epochs", type=int, default=40)
     f.add_argument("--width", type=int, default=64)
     f.add_argument("--json", action="store_true")
+    a = sub.add_parser("attach", help="write a frame search that acts on a ranker")
+    a.add_argument("skill", choices=PRIMITIVES)
+    a.add_argument("--ranker", required=True, help="the ranker file (fit's --out)")
+    a.add_argument("--frames", default="shipped", help="the frame search to extend (default: the shipped one)")
+    a.add_argument("--sensor", choices=SENSORS, default="cameras",
+                   help="whose shipped frame search (default: cameras)")
+    a.add_argument("--out", required=True, help="folder to write {skill}_frames.json and {skill}_ranker.pt into")
     return p
 
 
@@ -257,6 +288,9 @@ def main(argv: list[str] | None = None) -> int:
             out = collect(args.skill, args.out, args.starts, args.params, args.objects, args.sensor, args.seed,
                           args.chunk)
             print(f"collected {args.starts} starts of {args.skill} into {out}")
+            return 0
+        if args.command == "attach":
+            print(f"wrote {attach(args.skill, args.ranker, args.out, args.frames, args.sensor)}")
             return 0
         info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, progress=not args.json)
     except AffordplanError as exc:

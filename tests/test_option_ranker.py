@@ -1,0 +1,137 @@
+"""The option ranker: its features, its file, and a frame search that acts on its ranking."""
+
+import numpy as np
+import pytest
+import torch
+
+import affordplan as ap
+from affordplan.errors import InputError, WeightsError
+from primitives import weights_file
+from primitives.frames import FrameSearch, free_frames
+from primitives.option_ranker import (
+    N_FEATURES,
+    N_OPTION,
+    OptionRanker,
+    cloud_extents,
+    load_ranker,
+    option_features,
+    request_size,
+    save_ranker,
+)
+from primitives.success_model import N_DECISION
+from primitives.training.env import skill_observation
+from primitives.training.evaluate import load_policy
+
+
+def _features(m: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return option_features(rng.normal(size=(m, N_DECISION)), rng.uniform(0.05, 0.95, m), rng.uniform(0, 0.8, m),
+                           rng.random(m) < 0.5, rng.random(m) < 0.5, np.array([0.4, 0.3, 0.2]))
+
+
+def test_option_features_carry_each_option_and_its_difference_from_the_starts_mean():
+    x = _features(7)
+    assert x.shape == (7, N_FEATURES) and x.dtype == np.float32
+    own, centred = x[:, :N_OPTION], x[:, N_OPTION:]
+    assert np.allclose(centred, own - own.mean(axis=0), atol=1e-5)
+    assert np.allclose(centred.sum(axis=0), 0.0, atol=1e-4)
+    assert np.allclose(own[:, -3:], [0.4, 0.3, 0.2])  # the cloud's extents, the same for every option
+    assert np.allclose(centred[:, -3:], 0.0)
+    one = _features(1)  # a start with one option: nothing sets it apart
+    assert np.allclose(one[:, N_OPTION:], 0.0)
+
+
+def test_cloud_extents_are_the_same_in_every_frame_a_search_tries():
+    sim = ap.Simulator(ap.load_object("mug"), seed=3)
+    sim.reset(yaw=0.4)
+    points, _ = sim.point_cloud(256)
+    e = cloud_extents(points)
+    assert e.shape == (3,) and np.all(np.diff(e) <= 0) and np.all(e > 0)
+    for B in free_frames("push", None, 6, True):
+        assert np.allclose(cloud_extents(points @ B.T), e, atol=1e-9)
+    assert 0.05 < e[0] < 0.5  # dm: a mug's cloud spreads a few centimetres
+
+
+def test_request_size_is_a_spins_asked_turn():
+    assert request_size("spin", {"angle": -0.5}) == pytest.approx(0.5)
+    assert request_size("spin", None) == 0.0
+    assert request_size("push", {"direction": 2.0}) == 0.0
+    assert request_size("roll", {"target": 1}) == 0.0
+
+
+def test_a_ranker_file_round_trips_and_is_checked(tmp_path):
+    torch.manual_seed(0)
+    ranker = OptionRanker(16)
+    ranker.mean.copy_(torch.linspace(-1, 1, N_FEATURES))
+    path = tmp_path / "spin_ranker.pt"
+    save_ranker(path, ranker, "spin", "cameras", {"starts": 3})
+    back = load_ranker(path, "spin")
+    x = _features(5)
+    assert np.allclose(back.score(x), ranker.eval().score(x))
+    assert np.all((back.score(x) > 0) & (back.score(x) < 1))
+    assert weights_file.load(path, kind="ranker")[1]["sensor"] == "cameras"
+    with pytest.raises(WeightsError, match="push"):
+        load_ranker(path, "push")
+    with pytest.raises(WeightsError, match="not a ranker"):
+        load_ranker(weights_file.rating_path("spin", "success"))
+    torch.save({"not": "a ranker"}, tmp_path / "bare.pt")
+    with pytest.raises(WeightsError, match="metadata"):
+        load_ranker(tmp_path / "bare.pt")
+
+
+class _Pick(OptionRanker):
+    """A stand-in ranker that rates one option (by its row in the batch) above every other."""
+
+    def __init__(self, row: int):
+        super().__init__(4)
+        self.row = row
+
+    def score(self, features):
+        p = np.full(len(features), 0.1)
+        p[self.row] = 0.9
+        return p
+
+
+def test_a_search_with_a_ranker_acts_where_the_ranker_says_and_reports_that_frames_rating(tmp_path):
+    sim = ap.Simulator(ap.load_object("cube"), seed=0, sensor="surface")
+    sim.reset()
+    seen = skill_observation(sim, "spin", {"angle": 0.5}, 64)
+    policy = load_policy(None, "spin")
+    frames = free_frames("spin", None, 6, False)
+
+    def rating(obs):  # the ratings would pick frame 0
+        return np.linspace(0.8, 0.3, len(obs))
+
+    plain = FrameSearch(6, False)
+    chosen, p = plain.select("spin", seen, rating, sim)
+    assert np.allclose(chosen.A_frame_world, seen.A_frame_world) and p == pytest.approx(0.8)
+    ranked = FrameSearch(6, False, ranker_file="spin_ranker.pt", ranker=_Pick(4))
+    chosen, p = ranked.select("spin", seen, rating, sim, policy=policy)
+    assert np.allclose(chosen.A_frame_world, frames[4] @ seen.A_frame_world)
+    assert p == pytest.approx(np.linspace(0.8, 0.3, 6)[4])  # the success model's rating of the ranked frame
+    with pytest.raises(InputError, match="policy"):
+        ranked.select("spin", seen, rating, sim)
+    with pytest.raises(InputError, match="ranker"):
+        FrameSearch(6, False, ranker_file="spin_ranker.pt")
+
+
+def test_a_frames_file_names_its_ranker_beside_it(tmp_path):
+    ranker = OptionRanker(8)
+    save_ranker(tmp_path / "spin_ranker.pt", ranker, "spin", "cameras", {})
+    search = FrameSearch(12, False, (0.9, 0.1), ranker_file="spin_ranker.pt", ranker=load_ranker(
+        tmp_path / "spin_ranker.pt"))
+    search.save(tmp_path / "spin_frames.json")
+    back = FrameSearch.load(tmp_path / "spin_frames.json")
+    assert back == search and back.ranker is not None and back.ranker_file == "spin_ranker.pt"
+    x = _features(4)
+    assert np.allclose(back.ranker.score(x), ranker.score(x))
+    plain = FrameSearch(12, False)
+    plain.save(tmp_path / "plain.json")
+    assert FrameSearch.load(tmp_path / "plain.json").ranker is None
+    text = (tmp_path / "spin_frames.json").read_text().replace('"spin_ranker.pt"', '"../spin_ranker.pt"')
+    (tmp_path / "far.json").write_text(text)
+    with pytest.raises(InputError, match="beside"):
+        FrameSearch.load(tmp_path / "far.json")
+    (tmp_path / "spin_ranker.pt").unlink()
+    with pytest.raises(WeightsError, match="no option ranker"):
+        FrameSearch.load(tmp_path / "spin_frames.json")

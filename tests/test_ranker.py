@@ -1,0 +1,66 @@
+"""Fitting an option ranker: every option of training starts executed (resumable), then the fit."""
+
+import json
+
+import numpy as np
+import pytest
+
+from primitives.frames import FrameSearch, load_frame_search
+from primitives.option_ranker import load_ranker
+from primitives.training.ranker import attach, collect, fit, main, pick_figures, read_collections
+
+
+def test_collect_executes_every_option_and_resumes_where_it_stopped(tmp_path):
+    out = collect("spin", tmp_path / "c", starts=3, params="random", chunk=2, progress=False)
+    rows, sensor = read_collections("spin", [out])
+    assert sensor == "cameras" and sorted(set(rows["start"])) == [0, 1, 2]
+    n_frames = len(load_frame_search("spin", "shipped", "cameras").frames("spin", {"angle": 0.3}))
+    assert len(rows["success"]) == 3 * n_frames  # a request's every free frame, executed
+    for s in range(3):
+        m = rows["start"] == s
+        assert rows["chosen"][m].sum() == 1 and rows["parameterised"][m].all() and not rows["stand_in"][m].any()
+        assert np.ptp(rows["extents"][m], axis=0).max() == 0.0
+    first = (tmp_path / "c" / "chunk_0001.npz").read_bytes()
+    (tmp_path / "c" / "chunk_0001.npz").unlink()  # killed before its last chunk was written
+    collect("spin", tmp_path / "c", starts=3, params="random", chunk=2, progress=False)
+    again, _ = read_collections("spin", [out])
+    assert all(np.array_equal(again[k], rows[k]) for k in rows)
+    assert (tmp_path / "c" / "chunk_0001.npz").stat().st_size == len(first)
+
+
+def test_pick_figures_score_the_option_a_ranking_acts_in():
+    success = np.array([0, 1, 0, 1, 1, 0], dtype=bool)
+    starts = np.array([0, 0, 0, 1, 1, 1])
+    f = pick_figures(np.array([0.1, 0.9, 0.2, 0.3, 0.1, 0.9]), success, starts)
+    assert f["pick"] == 0.5 and f["best"] == 1.0 and f["random"] == pytest.approx(0.5)
+    assert f["within_start_auroc"] == pytest.approx((1.0 + 0.0) / 2)  # start 1: its failure ranked first
+
+
+def test_fit_writes_a_ranker_that_loads_and_says_how_it_was_made(tmp_path):
+    out = collect("spin", tmp_path / "c", starts=5, params="random", chunk=5, progress=False)
+    info = fit("spin", [out], tmp_path / "spin_ranker.pt", epochs=3, width=8, progress=False)
+    assert info["starts"] == 5 and info["sensor"] == "cameras" and 1 <= info["epoch"] <= 3
+    assert 0.0 <= info["held_out"]["pick"] <= info["held_out"]["best"] <= 1.0
+    ranker = load_ranker(tmp_path / "spin_ranker.pt", "spin")
+    assert ranker.net[0].out_features == 8
+    with pytest.raises(Exception, match="roll"):
+        fit("roll", [out], tmp_path / "roll_ranker.pt", epochs=1, progress=False)
+    frames = attach("spin", tmp_path / "spin_ranker.pt", tmp_path / "cand")  # the shipped search, ranked
+    search = FrameSearch.load(frames)
+    shipped = load_frame_search("spin", "shipped", "cameras")
+    assert search.ranker_file == "spin_ranker.pt" and (tmp_path / "cand" / "spin_ranker.pt").exists()
+    assert (search.turns, search.mirror, search.platt, search.stand_ins) == (
+        shipped.turns, shipped.mirror, shipped.platt, shipped.stand_ins)
+    with pytest.raises(Exception, match="push"):
+        attach("push", tmp_path / "spin_ranker.pt", tmp_path / "other")
+    assert not (tmp_path / "other").exists()
+
+
+def test_the_command_refuses_held_out_objects_and_empty_folders(tmp_path, capsys):
+    assert main(["collect", "spin", "--starts", "2", "--objects", "housekeep:unseen", "--out", str(tmp_path)]) == 2
+    assert "held out" in capsys.readouterr().err
+    assert main(["fit", "spin", str(tmp_path), "--out", str(tmp_path / "r.pt")]) == 2
+    assert "no collected chunks" in capsys.readouterr().err
+    out = collect("spin", tmp_path / "c", starts=2, params="random", chunk=2, progress=False)
+    assert main(["fit", "spin", str(out), "--out", str(tmp_path / "r.pt"), "--epochs", "2", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["options"] == 24
