@@ -141,8 +141,8 @@ class FrameSearch:
     the set tried is the same from every frame; spin, roll: any number > 0; 0: none), and calibrate the chosen
     score with ``platt_stand_ins`` instead of ``platt_unparameterised``. ``info``: how the calibration was made
     (command, figures). ``ranker``: an :class:`~primitives.option_ranker.OptionRanker` that picks the option to
-    act in instead of the ratings (:meth:`choose`), loaded from the file ``ranker_file`` names beside the JSON
-    file (:meth:`load`); ``None``: the ratings pick.
+    act in for the seed's objective instead of the ratings (:meth:`ranks`, :meth:`choose`), loaded from the file
+    ``ranker_file`` names beside the JSON file (:meth:`load`); ``None``: the ratings pick.
     """
 
     turns: int = 1
@@ -171,6 +171,13 @@ class FrameSearch:
     def tries_stand_ins(self, params: dict | None) -> bool:
         """Whether this search tries stand-in requests for ``params`` (the seed's objective, with ``stand_ins``)."""
         return params is None and self.stand_ins > 0
+
+    def ranks(self, params: dict | None) -> bool:
+        """Whether this search's ranker picks the option for ``params``: the seed's objective (``None``), whose
+        stand-ins make many options, where the search has a ranker. A request with a parameter keeps the ratings'
+        pick: on ``housekeep:validation`` a ranker fitted to spins by an angle picked no better than the ratings
+        (``primitives/weights/RECORD.md``)."""
+        return self.ranker is not None and params is None
 
     def searches(self, skill: str, params: dict | None) -> bool:
         """Whether a request ``params`` of ``skill`` leaves this search more than one option to rate."""
@@ -255,10 +262,10 @@ class FrameSearch:
         stand-in request where one was chosen. The score is the best raw rating, or with stand-ins the best rating
         calibrated for its kind (module docstring); :meth:`calibrate` it with ``seen.params is not None``.
 
-        With a ranker, ``policy`` (the skill's) is required: the ranker picks from its decision in each option
-        (:meth:`rank`).
+        Where the ranker picks (:meth:`ranks`), ``policy`` (the skill's) is required: the ranker reads its
+        decision in each option (:meth:`rank`).
         """
-        if self.ranker is not None:
+        if self.ranks(seen.params):
             if policy is None:
                 raise InputError("a frame search with an option ranker needs the skill's policy to select")
             options = self.options(skill, seen, sim)

@@ -95,7 +95,7 @@ class _Pick(OptionRanker):
 def test_a_search_with_a_ranker_acts_where_the_ranker_says_and_reports_that_frames_rating(tmp_path):
     sim = ap.Simulator(ap.load_object("cube"), seed=0, sensor="surface")
     sim.reset()
-    seen = skill_observation(sim, "spin", {"angle": 0.5}, 64)
+    seen = skill_observation(sim, "spin", None, 64)  # the seed's objective: the ranker picks
     policy = load_policy(None, "spin")
     frames = free_frames("spin", None, 6, False)
 
@@ -113,6 +113,10 @@ def test_a_search_with_a_ranker_acts_where_the_ranker_says_and_reports_that_fram
         ranked.select("spin", seen, rating, sim)
     with pytest.raises(InputError, match="ranker"):
         FrameSearch(6, False, ranker_file="spin_ranker.pt")
+    asked = skill_observation(sim, "spin", {"angle": 0.5}, 64)  # a request with a parameter: the ratings pick
+    assert ranked.ranks(None) and not ranked.ranks(asked.params) and not plain.ranks(None)
+    chosen, p = ranked.select("spin", asked, rating, sim)
+    assert np.allclose(chosen.A_frame_world, asked.A_frame_world) and p == pytest.approx(0.8)
 
 
 def test_a_frames_file_names_its_ranker_beside_it(tmp_path):

@@ -147,7 +147,7 @@ def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSea
     start = sim.snapshot()
     options = search.options(skill, seen, sim)
     ratings = search.rate(options, predict)
-    ranking = search.rank(skill, options, ratings, policy) if search.ranker is not None else None
+    ranking = search.rank(skill, options, ratings, policy) if search.ranks(seen.params) else None
     k_pick, j_pick, _ = search.choose(options, ratings, ranking)
     option, frame, q_max, success = [], [], [], []
     for k, (_, frames) in enumerate(options):
