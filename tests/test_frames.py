@@ -300,8 +300,8 @@ def test_the_shipped_spin_acting_as_a_stand_in_turns_the_seeds_thirty_degrees():
     skill = load_skill("spin")
     assert skill.frame_search.tries_stand_ins(None) and not skill.frame_search.tries_stand_ins({"angle": 0.5})
 
-    def fresh():
-        sim = ap.Simulator(ap.load_object("mug"), seed=2)
+    def fresh():  # the surface sample: the ratings' own pick (with camera clouds spin's ranker picks instead,
+        sim = ap.Simulator(ap.load_object("mug"), seed=2, sensor="surface")  # test_option_ranker.py)
         sim.reset()
         return sim
 

@@ -139,3 +139,29 @@ def test_a_frames_file_names_its_ranker_beside_it(tmp_path):
     (tmp_path / "spin_ranker.pt").unlink()
     with pytest.raises(WeightsError, match="no option ranker"):
         FrameSearch.load(tmp_path / "spin_frames.json")
+
+
+def test_the_shipped_spin_ranks_its_options_with_camera_clouds_only():
+    """Spin's camera frame search carries the shipped ranker; its success models and the surface sample's search
+    are the policy's own, unchanged (the ranker was fitted on camera clouds)."""
+    from primitives import load_skill
+
+    spin = load_skill("spin")
+    cameras = spin.ratings("cameras")
+    assert spin.rated_sensors == ("surface", "cameras") and spin.frame_search.ranker is None
+    assert cameras.frame_search.ranks(None) and not cameras.frame_search.ranks({"angle": 0.4})
+    assert cameras._success_weights == weights_file.SHIPPED_DIR / "spin_success.pt"  # the policy's own
+    assert (cameras.frame_search.turns, cameras.frame_search.platt) == (spin.frame_search.turns,
+                                                                       spin.frame_search.platt)
+    sim = ap.Simulator(ap.load_object("mug"), seed=2)  # cameras, the default
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.3)
+    seen = skill_observation(sim, "spin", None, spin.n_points)
+    search = cameras.frame_search
+    options = search.options("spin", seen, sim)
+    ratings = search.rate(options, cameras.success_model.predict)
+    ranking = search.rank("spin", options, ratings, spin.model)
+    k = int(np.argmax([q.max() for q in ranking]))
+    wanted = search.acting(options, k, int(np.argmax(ranking[k])))
+    chosen, _ = search.select("spin", seen, cameras.success_model.predict, sim, policy=spin.model)  # as observe
+    assert np.allclose(chosen.obs, wanted.obs) and chosen.acted_as == wanted.acted_as
+    assert cameras.observe(sim, None).params is None  # the skill's own call goes through the ranked search

@@ -272,7 +272,8 @@ def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, 
     obs = push.observe(sim, {"direction": 0.0}).obs[None]  # rated by the searched model: the camera one differs
     assert push.success_probability_obs(obs, sensor="cameras") != pytest.approx(push.success_probability_obs(obs),
                                                                                 abs=1e-3)
-    assert load_skill("spin").rated_sensors == ("surface",)  # none shipped for cameras: its own serve every cloud
+    roll = load_skill("roll")  # its camera frame search has no ranker
+    assert roll.rated_sensors == ("surface", "cameras") and roll.ratings("cameras").frame_search.ranker is None
     assert load_skill("push", frame_search=False).rated_sensors == ("surface",)  # given files: those alone
 
 
