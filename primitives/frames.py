@@ -51,7 +51,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import torch
 from scipy.special import expit, logit
 
 from affordplan.checks import is_whole, require_whole
@@ -60,12 +59,10 @@ from affordplan.geometry import rot_z
 from primitives import params as skill_params
 from primitives.observation import OBS_DIM, SkillObservation, observe_cloud
 from primitives.option_ranker import OptionRanker, cloud_extents, load_ranker, option_features, request_size
-from primitives.success_model import decision_features
 from primitives.weights_file import rating_path
 
 if TYPE_CHECKING:
     from affordplan.sim import Simulator
-    from primitives.networks import HybridActorCritic
 
 MIRROR_Y = np.diag([1.0, -1.0, 1.0])
 
@@ -204,17 +201,24 @@ class FrameSearch:
         p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
         return np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
 
+    @staticmethod
+    def rate_and_decide(options: list[tuple[SkillObservation, np.ndarray]],
+                        decide) -> tuple[list[np.ndarray], np.ndarray]:
+        """Each option's ratings (split as :meth:`rate` splits them) and the policy's decision features in each
+        option's frame ``(m, 14)``, from one batch of ``decide`` (observations ``(m, N, 9)`` -> ``(P(success) (m,),
+        decision features (m, 14))``, e.g. :meth:`primitives.success_model.SuccessModel.rate_and_decide`)."""
+        p, decision = decide(np.concatenate([reframe_obs(o.obs, f) for o, f in options]))
+        return np.split(np.asarray(p, dtype=float), np.cumsum([len(f) for _, f in options])[:-1]), decision
+
     def rank(self, skill: str, options: list[tuple[SkillObservation, np.ndarray]], ratings: list[np.ndarray],
-             policy: HybridActorCritic) -> list[np.ndarray]:
-        """This search's ranker's P(success) of each option's frames (split as ``ratings``), from ``policy``'s
-        decision in each (:mod:`primitives.option_ranker`). Raises :class:`InputError` without a ranker."""
+             decision: np.ndarray) -> list[np.ndarray]:
+        """This search's ranker's P(success) of each option's frames (split as ``ratings``), from the policy's
+        ``decision`` features in each (:meth:`rate_and_decide`; :mod:`primitives.option_ranker`). Raises
+        :class:`InputError` without a ranker."""
         if self.ranker is None:
             raise InputError("this frame search has no option ranker")
-        obs = np.concatenate([reframe_obs(o.obs, f) for o, f in options])
-        with torch.no_grad():
-            _, _, decision = decision_features(policy, torch.from_numpy(obs))
         kinds = [(o.params, k > 0) for k, (o, f) in enumerate(options) for _ in range(len(f))]
-        features = option_features(decision.numpy(), np.concatenate(ratings),
+        features = option_features(np.asarray(decision), np.concatenate(ratings),
                                    np.array([request_size(skill, p) for p, _ in kinds]),
                                    np.array([p is not None for p, _ in kinds]), np.array([s for _, s in kinds]),
                                    cloud_extents(options[0][0].obs[:, :3]))
@@ -252,7 +256,7 @@ class FrameSearch:
         return replace(chosen, params=None, acted_as=option.params) if k else chosen
 
     def select(self, skill: str, seen: SkillObservation, predict, sim: Simulator,
-               policy: HybridActorCritic | None = None) -> tuple[SkillObservation, float]:
+               decide=None) -> tuple[SkillObservation, float]:
         """The observation to act on and its score: ``seen`` (of ``sim``'s current cloud) in the free frame, or
         for the seed's objective with stand-ins the free frame of the stand-in request, that ``predict``
         (observations ``(m, N, 9)`` -> P(success) ``(m,)``) rates likeliest, all in one batch
@@ -262,15 +266,17 @@ class FrameSearch:
         stand-in request where one was chosen. The score is the best raw rating, or with stand-ins the best rating
         calibrated for its kind (module docstring); :meth:`calibrate` it with ``seen.params is not None``.
 
-        Where the ranker picks (:meth:`ranks`), ``policy`` (the skill's) is required: the ranker reads its
-        decision in each option (:meth:`rank`).
+        Where the ranker picks (:meth:`ranks`), ``decide`` is required: the ratings and the policy's decision
+        features in one pass (:meth:`rate_and_decide`), which the ranker reads (:meth:`rank`); it rates in place
+        of ``predict`` there.
         """
         if self.ranks(seen.params):
-            if policy is None:
-                raise InputError("a frame search with an option ranker needs the skill's policy to select")
+            if decide is None:
+                raise InputError("a frame search with an option ranker needs decide (the ratings and the policy's "
+                                 "decisions) to select")
             options = self.options(skill, seen, sim)
-            ratings = self.rate(options, predict)
-            k, j, score = self.choose(options, ratings, self.rank(skill, options, ratings, policy))
+            ratings, decision = self.rate_and_decide(options, decide)
+            k, j, score = self.choose(options, ratings, self.rank(skill, options, ratings, decision))
             return self.acting(options, k, j), score
         if not self.tries_stand_ins(seen.params):
             return select_frame(seen, predict, self.frames(skill, seen.params))

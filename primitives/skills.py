@@ -111,7 +111,8 @@ class Skill:
         seen = skill_observation(sim, self.name, as_params(self.name, params), self.n_points)
         if self.frame_search is None or not self.frame_search.searches(self.name, seen.params):
             return seen, None
-        seen, p = self.frame_search.select(self.name, seen, self.success_model.predict, sim, policy=self.model)
+        seen, p = self.frame_search.select(self.name, seen, self.success_model.predict, sim,
+                                          decide=self.success_model.rate_and_decide)
         return seen, float(self.frame_search.calibrate(p, seen.params is not None))
 
     def observe(self, sim: Simulator, params: ParamsLike = None) -> SkillObservation:

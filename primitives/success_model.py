@@ -168,6 +168,14 @@ class SuccessModel:
         return self._per_observation(obs, lambda x, d: self._stacked(x, d))
 
     @torch.no_grad()
+    def rate_and_decide(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """P(success) ``(B,)`` for observations ``(B, N, 9)`` and the policy's decision features ``(B, 14)``
+        (:func:`decision_features`) it read them with, from one pass of the policy."""
+        x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
+        _, _, d = decision_features(self.policy, x)
+        return self._stacked(x, d).numpy(), d.numpy()
+
+    @torch.no_grad()
     def spread(self, obs: np.ndarray) -> np.ndarray:
         """The members' disagreement on P(success) for observations ``(N, 9)`` or ``(B, N, 9)``: the standard
         deviation of their calibrated probabilities (0 for a one-member net). Low on observations like those the

@@ -18,7 +18,7 @@ from primitives.option_ranker import (
     request_size,
     save_ranker,
 )
-from primitives.success_model import N_DECISION
+from primitives.success_model import N_DECISION, decision_features
 from primitives.training.env import skill_observation
 from primitives.training.evaluate import load_policy
 
@@ -102,14 +102,17 @@ def test_a_search_with_a_ranker_acts_where_the_ranker_says_and_reports_that_fram
     def rating(obs):  # the ratings would pick frame 0
         return np.linspace(0.8, 0.3, len(obs))
 
+    def decide(obs):  # the same ratings, and the policy's decisions
+        return rating(obs), decision_features(policy, torch.from_numpy(obs))[2].numpy()
+
     plain = FrameSearch(6, False)
     chosen, p = plain.select("spin", seen, rating, sim)
     assert np.allclose(chosen.A_frame_world, seen.A_frame_world) and p == pytest.approx(0.8)
     ranked = FrameSearch(6, False, ranker_file="spin_ranker.pt", ranker=_Pick(4))
-    chosen, p = ranked.select("spin", seen, rating, sim, policy=policy)
+    chosen, p = ranked.select("spin", seen, rating, sim, decide=decide)
     assert np.allclose(chosen.A_frame_world, frames[4] @ seen.A_frame_world)
     assert p == pytest.approx(np.linspace(0.8, 0.3, 6)[4])  # the success model's rating of the ranked frame
-    with pytest.raises(InputError, match="policy"):
+    with pytest.raises(InputError, match="decide"):
         ranked.select("spin", seen, rating, sim)
     with pytest.raises(InputError, match="ranker"):
         FrameSearch(6, False, ranker_file="spin_ranker.pt")
@@ -158,10 +161,13 @@ def test_the_shipped_spin_ranks_its_options_with_camera_clouds_only():
     seen = skill_observation(sim, "spin", None, spin.n_points)
     search = cameras.frame_search
     options = search.options("spin", seen, sim)
-    ratings = search.rate(options, cameras.success_model.predict)
-    ranking = search.rank("spin", options, ratings, spin.model)
+    ratings, decision = search.rate_and_decide(options, cameras.success_model.rate_and_decide)
+    plain = search.rate(options, cameras.success_model.predict)  # the same ratings, in one pass with the decisions
+    assert all(np.allclose(a, b, atol=1e-5) for a, b in zip(ratings, plain))
+    ranking = search.rank("spin", options, ratings, decision)
     k = int(np.argmax([q.max() for q in ranking]))
     wanted = search.acting(options, k, int(np.argmax(ranking[k])))
-    chosen, _ = search.select("spin", seen, cameras.success_model.predict, sim, policy=spin.model)  # as observe
+    chosen, _ = search.select("spin", seen, cameras.success_model.predict, sim,  # as observe
+                              decide=cameras.success_model.rate_and_decide)
     assert np.allclose(chosen.obs, wanted.obs) and chosen.acted_as == wanted.acted_as
     assert cameras.observe(sim, None).params is None  # the skill's own call goes through the ranked search

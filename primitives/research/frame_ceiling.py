@@ -140,14 +140,15 @@ class FrameCeiling:
 
 
 @torch.no_grad()
-def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSearch, predict) -> StartOptions:
+def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSearch,
+                  rater: SuccessModel) -> StartOptions:
     """Execute every option of ``search`` on ``env``'s current start, restoring the start before each (and after
-    the last)."""
+    the last); ``rater`` rates the options (and gives the policy's decisions to a ranker)."""
     skill, sim, seen = env.config.primitive, env.sim, env.seen
     start = sim.snapshot()
     options = search.options(skill, seen, sim)
-    ratings = search.rate(options, predict)
-    ranking = search.rank(skill, options, ratings, policy) if search.ranks(seen.params) else None
+    ratings, decision = search.rate_and_decide(options, rater.rate_and_decide)
+    ranking = search.rank(skill, options, ratings, decision) if search.ranks(seen.params) else None
     k_pick, j_pick, _ = search.choose(options, ratings, ranking)
     option, frame, q_max, success = [], [], [], []
     for k, (_, frames) in enumerate(options):
@@ -179,7 +180,7 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
     :func:`primitives.training.evaluate.object_list` takes (e.g. ``"housekeep:validation"``), the starts then
     cycling through its objects; ``sensor``: the clouds the policy and the ratings see."""
     policy = load_policy(weights, skill)
-    predict = SuccessModel(policy, load_success_net(skill, model, sensor)).predict
+    rater = SuccessModel(policy, load_success_net(skill, model, sensor))
     search = load_frame_search(skill, frames, sensor)
     p_params = 1.0 if params == "random" else 0.0
     if objects == "random":
@@ -191,7 +192,7 @@ def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: i
     out = FrameCeiling(skill, params, [], objects, sensor)
     for key in tqdm(keys, desc=f"{skill} frame ceiling", disable=not progress, unit="start", mininterval=2.0):
         env.reset(object_key=key)
-        out.starts.append(start_options(env, policy, search, predict))
+        out.starts.append(start_options(env, policy, search, rater))
     env.close()
     return out
 

@@ -135,11 +135,12 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
     ``frame_search``: act in the free goal frame the success model (``success_weights``; by default the shipped
     one for ``sensor``'s clouds) rates likeliest (:mod:`primitives.frames`), and record its calibrated ratings.
     """
-    predict = None
+    predict = decide = None
     if frame_search is not None:
         from primitives.training.success import SuccessModel, load_success_net
 
-        predict = SuccessModel(model, load_success_net(primitive, success_weights, sensor)).predict
+        rater = SuccessModel(model, load_success_net(primitive, success_weights, sensor))
+        predict, decide = rater.predict, rater.rate_and_decide
     if objects == "random":
         cfg = held_out_config(primitive, p_params, sensor)
         plan = [None] * trials
@@ -154,7 +155,7 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
         obs = env.reset(object_key=key)
         if predict is not None:
             params = env.seen.params
-            env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim, policy=model)
+            env.seen, rating = frame_search.select(primitive, env.seen, predict, env.sim, decide=decide)
             obs = env.seen.obs
             if frame_search.searches(primitive, params):
                 result.frames = (f"best of {len(frame_search.frames(primitive, params))} free frames"

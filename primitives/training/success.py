@@ -221,7 +221,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
                mininterval=2.0)
     while len(rows) < n:
         obs = env.reset()
-        env.seen, p = search.select(skill, env.seen, model.predict, env.sim, policy=model.policy)
+        env.seen, p = search.select(skill, env.seen, model.predict, env.sim, decide=model.rate_and_decide)
         idx, motion, _ = greedy_action(model.policy, env.seen.obs)
         res = env.step(idx, motion)
         if not res.valid:
