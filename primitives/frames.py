@@ -126,6 +126,16 @@ def stand_in_requests(skill: str, n: int, obj, state: int) -> list[dict]:
     return [{"target": t} for t in skill_params.roll_targets(obj, state)]
 
 
+def _all_frames(options: list[tuple[SkillObservation, np.ndarray]]) -> np.ndarray:
+    """Every option's observation in each of its frames, one batch ``(m, N, 9)`` in the options' order."""
+    return np.concatenate([reframe_obs(o.obs, f) for o, f in options])
+
+
+def _per_option(values: np.ndarray, options: list[tuple[SkillObservation, np.ndarray]]) -> list[np.ndarray]:
+    """``values`` of a batch of :func:`_all_frames` split back into one array per option (one value per frame)."""
+    return np.split(values, np.cumsum([len(f) for _, f in options])[:-1])
+
+
 @dataclass(frozen=True)
 class FrameSearch:
     """Which free frames a skill tries, and the calibration of the chosen frame's rating.
@@ -198,8 +208,7 @@ class FrameSearch:
     def rate(options: list[tuple[SkillObservation, np.ndarray]], predict) -> list[np.ndarray]:
         """Each option's ratings, one per frame, from one batch of ``predict`` (observations ``(m, N, 9)`` ->
         P(success) ``(m,)``)."""
-        p = np.asarray(predict(np.concatenate([reframe_obs(o.obs, f) for o, f in options])), dtype=float)
-        return np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
+        return _per_option(np.asarray(predict(_all_frames(options)), dtype=float), options)
 
     @staticmethod
     def rate_and_decide(options: list[tuple[SkillObservation, np.ndarray]],
@@ -207,8 +216,8 @@ class FrameSearch:
         """Each option's ratings (split as :meth:`rate` splits them) and the policy's decision features in each
         option's frame ``(m, 14)``, from one batch of ``decide`` (observations ``(m, N, 9)`` -> ``(P(success) (m,),
         decision features (m, 14))``, e.g. :meth:`primitives.success_model.SuccessModel.rate_and_decide`)."""
-        p, decision = decide(np.concatenate([reframe_obs(o.obs, f) for o, f in options]))
-        return np.split(np.asarray(p, dtype=float), np.cumsum([len(f) for _, f in options])[:-1]), decision
+        p, decision = decide(_all_frames(options))
+        return _per_option(np.asarray(p, dtype=float), options), decision
 
     def rank(self, skill: str, options: list[tuple[SkillObservation, np.ndarray]], ratings: list[np.ndarray],
              decision: np.ndarray) -> list[np.ndarray]:
@@ -222,8 +231,7 @@ class FrameSearch:
                                    np.array([request_size(skill, p) for p, _ in kinds]),
                                    np.array([p is not None for p, _ in kinds]), np.array([s for _, s in kinds]),
                                    cloud_extents(options[0][0].obs[:, :3]))
-        p = self.ranker.score(features)
-        return np.split(p, np.cumsum([len(f) for _, f in options])[:-1])
+        return _per_option(self.ranker.score(features), options)
 
     def choose(self, options: list[tuple[SkillObservation, np.ndarray]], ratings: list[np.ndarray],
                ranking: list[np.ndarray] | None = None) -> tuple[int, int, float]:

@@ -26,6 +26,9 @@ def test_collect_executes_every_option_and_resumes_where_it_stopped(tmp_path):
     again, _ = read_collections("spin", [out])
     assert all(np.array_equal(again[k], rows[k]) for k in rows)
     assert (tmp_path / "c" / "chunk_0001.npz").stat().st_size == len(first)
+    assert not list((tmp_path / "c").glob("*.tmp"))
+    (tmp_path / "c" / "chunk_0002.npz.tmp").write_bytes(first[:100])  # a write killed half-way: not a chunk
+    assert np.array_equal(read_collections("spin", [out])[0]["start"], rows["start"])
 
 
 def test_pick_figures_score_the_option_a_ranking_acts_in():

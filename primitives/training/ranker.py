@@ -44,6 +44,7 @@ from affordplan.log import cli_logging
 from affordplan.sim.sensor import SENSORS
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.option_ranker import (
+    N_FEATURES,
     OptionRanker,
     cloud_extents,
     load_ranker,
@@ -124,10 +125,11 @@ def collect(skill: str, out: str | Path, starts: int, params: str = "none", obje
             rows["start"].append(np.full(len(got["success"]), s))
             bar.update(1)
         env.close()
-        tmp = path.with_suffix(".tmp.npz")
-        np.savez(tmp, **{key: np.concatenate(v) for key, v in rows.items()},
-                 meta=np.array(json.dumps(dict(skill=skill, params=params, objects=objects, sensor=sensor,
-                                               seed=seed, chunk=chunk))))
+        tmp = path.with_name(path.name + ".tmp")  # not chunk_*.npz: a write killed half-way is never read
+        with open(tmp, "wb") as f:
+            np.savez(f, **{key: np.concatenate(v) for key, v in rows.items()},
+                     meta=np.array(json.dumps(dict(skill=skill, params=params, objects=objects, sensor=sensor,
+                                                   seed=seed, chunk=chunk))))
         tmp.replace(path)
     bar.close()
     return out
@@ -163,7 +165,7 @@ def features_of(rows: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np
     """``(features, success, start)`` of collected rows, the features made start by start
     (:func:`option_features`)."""
     starts = rows["start"]
-    features = np.zeros((len(starts), 2 * (rows["decision"].shape[1] + 7)), dtype=np.float32)
+    features = np.zeros((len(starts), N_FEATURES), dtype=np.float32)
     for s in np.unique(starts):
         m = starts == s
         features[m] = option_features(rows["decision"][m], rows["rating"][m], rows["request"][m],
