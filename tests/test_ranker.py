@@ -64,6 +64,9 @@ def test_the_command_refuses_held_out_objects_and_empty_folders(tmp_path, capsys
     assert "held out" in capsys.readouterr().err
     assert main(["fit", "spin", str(tmp_path), "--out", str(tmp_path / "r.pt")]) == 2
     assert "no collected chunks" in capsys.readouterr().err
+    one = collect("spin", tmp_path / "one", starts=1, params="random", progress=False)
+    assert main(["fit", "spin", str(one), "--out", str(tmp_path / "r.pt")]) == 2
+    assert "at least 2" in capsys.readouterr().err and not (tmp_path / "r.pt").exists()
     out = collect("spin", tmp_path / "c", starts=2, params="random", chunk=2, progress=False)
     assert main(["fit", "spin", str(out), "--out", str(tmp_path / "r.pt"), "--epochs", "2", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["options"] == 24

@@ -195,6 +195,8 @@ def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, e
     x, y, starts = features_of(rows)
     rng = np.random.default_rng(seed)
     ids = np.unique(starts)
+    if len(ids) < 2:
+        raise InputError(f"fitting a ranker needs at least 2 collected starts (one is held out), got {len(ids)}")
     held = np.isin(starts, rng.choice(ids, size=max(1, len(ids) // 5), replace=False))
     torch.manual_seed(seed)
     ranker = OptionRanker(width)
