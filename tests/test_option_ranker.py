@@ -59,13 +59,25 @@ def test_request_size_is_a_spins_asked_turn():
     assert request_size("roll", {"target": 1}) == 0.0
 
 
+def test_an_ensembles_logit_is_its_members_mean():
+    torch.manual_seed(0)
+    ranker = OptionRanker(8, members=3).eval()
+    x = torch.from_numpy(_features(6))
+    each = ranker.member_logits(x)
+    assert each.shape == (3, 6) and not torch.allclose(each[0], each[1])
+    assert torch.allclose(ranker(x), each.mean(dim=0))
+    with pytest.raises(InputError, match="positive"):
+        OptionRanker(8, members=0)
+
+
 def test_a_ranker_file_round_trips_and_is_checked(tmp_path):
     torch.manual_seed(0)
-    ranker = OptionRanker(16)
+    ranker = OptionRanker(16, members=2)
     ranker.mean.copy_(torch.linspace(-1, 1, N_FEATURES))
     path = tmp_path / "spin_ranker.pt"
     save_ranker(path, ranker, "spin", "cameras", {"starts": 3})
     back = load_ranker(path, "spin")
+    assert back.width == 16 and len(back.nets) == 2
     x = _features(5)
     assert np.allclose(back.score(x), ranker.eval().score(x))
     assert np.all((back.score(x) > 0) & (back.score(x) < 1))

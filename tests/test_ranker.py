@@ -7,7 +7,7 @@ import pytest
 
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.option_ranker import load_ranker
-from primitives.training.ranker import attach, collect, fit, main, pick_figures, read_collections
+from primitives.training.ranker import attach, collect, features_of, fit, main, pick_figures, read_collections
 
 
 def test_collect_executes_every_option_and_resumes_where_it_stopped(tmp_path):
@@ -41,11 +41,17 @@ def test_pick_figures_score_the_option_a_ranking_acts_in():
 
 def test_fit_writes_a_ranker_that_loads_and_says_how_it_was_made(tmp_path):
     out = collect("spin", tmp_path / "c", starts=5, params="random", chunk=5, progress=False)
-    info = fit("spin", [out], tmp_path / "spin_ranker.pt", epochs=3, width=8, progress=False)
+    info = fit("spin", [out], tmp_path / "spin_ranker.pt", epochs=3, width=8, members=3, progress=False)
     assert info["starts"] == 5 and info["sensor"] == "cameras" and 1 <= info["epoch"] <= 3
+    assert info["members"] == 3 and info["refit"] and "--members 3" in info["command"]
     assert 0.0 <= info["held_out"]["pick"] <= info["held_out"]["best"] <= 1.0
     ranker = load_ranker(tmp_path / "spin_ranker.pt", "spin")
-    assert ranker.net[0].out_features == 8
+    assert ranker.width == 8 and len(ranker.nets) == 3
+    kept = fit("spin", [out], tmp_path / "kept.pt", epochs=3, width=8, members=3, refit=False, progress=False)
+    assert kept["held_out"] == info["held_out"]  # the same choice, made before the refit
+    rows, _ = read_collections("spin", [out])
+    x = features_of(rows)[0]
+    assert not np.allclose(load_ranker(tmp_path / "kept.pt").score(x), ranker.score(x))  # refitted on all starts
     with pytest.raises(Exception, match="roll"):
         fit("roll", [out], tmp_path / "roll_ranker.pt", epochs=1, progress=False)
     frames = attach("spin", tmp_path / "spin_ranker.pt", tmp_path / "cand")  # the shipped search, ranked
@@ -70,3 +76,5 @@ def test_the_command_refuses_held_out_objects_and_empty_folders(tmp_path, capsys
     out = collect("spin", tmp_path / "c", starts=2, params="random", chunk=2, progress=False)
     assert main(["fit", "spin", str(out), "--out", str(tmp_path / "r.pt"), "--epochs", "2", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["options"] == 24
+    assert main(["fit", "spin", str(out), "--out", str(tmp_path / "r0.pt"), "--members", "0"]) == 2
+    assert "--members" in capsys.readouterr().err and not (tmp_path / "r0.pt").exists()

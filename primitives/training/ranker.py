@@ -13,11 +13,12 @@ Starts come in chunks of ``--chunk``, each from an environment seeded by ``(seed
 ``chunk_NNNN.npz`` when done: a collection killed at any moment resumes at its first missing chunk, and gives the
 same data as one never stopped.
 
-**fit** trains :class:`primitives.option_ranker.OptionRanker` with a binary cross-entropy on the options of the
-collected starts, a fifth of the starts (drawn with ``--seed``) held out; it keeps the epoch whose held-out
-*pick* (the success of the option it would act in, averaged over the held-out starts) is highest, and reports that
-pick beside the success model's pick, the best option and an option at random. The training is a few minutes of one
-core; nothing of it is checkpointed.
+**fit** trains :class:`primitives.option_ranker.OptionRanker` (an ensemble of ``--members`` MLPs) with a binary
+cross-entropy on the options of the collected starts, a fifth of the starts (drawn with ``--seed``) held out; it
+chooses the epoch whose held-out *pick* (the success of the option it would act in, averaged over the held-out
+starts) is highest, reports that pick beside the success model's pick, the best option and an option at random,
+and saves a ranker trained afresh on every start for that many epochs (``--no-refit``: the chosen epoch's own).
+The training is a few minutes of one core; nothing of it is checkpointed.
 
 **attach** writes a frame search that acts on a ranker: the shipped frame search for ``--sensor`` (or ``--frames``)
 with the ranker's file named in it, both into the folder ``--out`` (``{skill}_frames.json``, ``{skill}_ranker.pt``),
@@ -187,9 +188,40 @@ def pick_figures(score: np.ndarray, success: np.ndarray, starts: np.ndarray) -> 
                 random=float(np.mean(rand)), within_start_auroc=float(np.mean(aucs)) if aucs else float("nan"))
 
 
-def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, epochs: int = 40, width: int = 64,
-        weight_decay: float = 1e-4, progress: bool = True) -> dict:
-    """Fit and save an option ranker on collected options (module docstring); returns what it printed."""
+def _train(x: np.ndarray, y: np.ndarray, epochs: int, width: int, members: int, weight_decay: float, seed: int,
+           progress: bool, desc: str, judge=None) -> tuple[OptionRanker, list[float]]:
+    """An :class:`OptionRanker` of ``members`` MLPs trained side by side for ``epochs`` epochs of a binary
+    cross-entropy on ``(x, y)`` (each member its own initialisation and batch order, from ``seed``), and
+    ``judge(ranker)`` after each epoch where given."""
+    torch.manual_seed(seed)
+    ranker = OptionRanker(width, members)
+    ranker.mean.copy_(torch.from_numpy(x.mean(axis=0)))
+    ranker.scale.copy_(torch.from_numpy(x.std(axis=0) + 1e-6))
+    xt, yt = (torch.from_numpy(x) - ranker.mean) / ranker.scale, torch.from_numpy(y)
+    opts = [torch.optim.AdamW(net.parameters(), lr=1e-3, weight_decay=weight_decay) for net in ranker.nets]
+    loss_fn = nn.BCEWithLogitsLoss()
+    judged = []
+    for _ in tqdm(range(epochs), desc=desc, disable=not progress):
+        ranker.train()
+        for net, opt in zip(ranker.nets, opts):
+            for batch in torch.randperm(len(xt)).split(256):
+                opt.zero_grad()
+                loss_fn(net(xt[batch]).squeeze(-1), yt[batch]).backward()
+                opt.step()
+        ranker.eval()
+        if judge is not None:
+            judged.append(judge(ranker))
+    return ranker, judged
+
+
+def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, epochs: int = 20, width: int = 64,
+        members: int = 5, weight_decay: float = 1e-4, refit: bool = True, progress: bool = True) -> dict:
+    """Fit and save an option ranker on collected options (module docstring); returns what it printed.
+
+    A fifth of the starts (drawn with ``seed``) is held out to choose the number of epochs (the one whose held-out
+    pick is highest) and to report the figures; with ``refit`` the saved ranker is then trained afresh on every
+    start for that many epochs, otherwise it is the ranker of the chosen epoch, fitted without the held-out starts.
+    """
     t0 = time.perf_counter()
     rows, sensor = read_collections(skill, folders)
     x, y, starts = features_of(rows)
@@ -197,37 +229,31 @@ def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, e
     ids = np.unique(starts)
     if len(ids) < 2:
         raise InputError(f"fitting a ranker needs at least 2 collected starts (one is held out), got {len(ids)}")
+    if epochs < 1 or width < 1 or members < 1:
+        raise InputError(f"--epochs, --width and --members must be positive, got {epochs}, {width} and {members}")
     held = np.isin(starts, rng.choice(ids, size=max(1, len(ids) // 5), replace=False))
-    torch.manual_seed(seed)
-    ranker = OptionRanker(width)
-    ranker.mean.copy_(torch.from_numpy(x[~held].mean(axis=0)))
-    ranker.scale.copy_(torch.from_numpy(x[~held].std(axis=0) + 1e-6))
-    xt, yt = torch.from_numpy(x[~held]), torch.from_numpy(y[~held])
-    opt = torch.optim.AdamW(ranker.parameters(), lr=1e-3, weight_decay=weight_decay)
-    loss_fn = nn.BCEWithLogitsLoss()
-    best_pick, best_state, best_epoch = -1.0, None, 0
-    for epoch in tqdm(range(epochs), desc=f"{skill} ranker", disable=not progress):
-        ranker.train()
-        for batch in torch.randperm(len(xt)).split(256):
-            opt.zero_grad()
-            loss_fn(ranker(xt[batch]), yt[batch]).backward()
-            opt.step()
-        ranker.eval()
-        pick = pick_figures(ranker.score(x[held]), y[held], starts[held])["pick"]
-        if pick > best_pick:
-            best_pick, best_epoch = pick, epoch + 1
-            best_state = {k: v.clone() for k, v in ranker.state_dict().items()}
-    ranker.load_state_dict(best_state)
-    ranker.eval()
+    states: list[dict] = []
+
+    def judge(ranker: OptionRanker) -> float:
+        states.append({k: v.clone() for k, v in ranker.state_dict().items()})
+        return pick_figures(ranker.score(x[held]), y[held], starts[held])["pick"]
+
+    ranker, picks = _train(x[~held], y[~held], epochs, width, members, weight_decay, seed, progress,
+                           f"{skill} ranker", judge)
+    best_epoch = int(np.argmax(picks)) + 1
+    ranker.load_state_dict(states[best_epoch - 1])
     figures = dict(held_out=pick_figures(ranker.score(x[held]), y[held], starts[held]),
                    ratings_held_out=pick_figures(rows["rating"][held], y[held], starts[held]),
                    search_pick_held_out=float(np.mean([rows["success"][held & (starts == s) & rows["chosen"]].any()
                                                        for s in np.unique(starts[held])])),
                    train=pick_figures(ranker.score(x[~held]), y[~held], starts[~held]))
+    if refit:
+        ranker, _ = _train(x, y, best_epoch, width, members, weight_decay, seed, progress, f"{skill} refit")
     info = dict(command=" ".join(["python -m primitives.training.ranker fit", skill, *map(str, folders), "--out",
-                                  str(out), "--seed", str(seed), "--epochs", str(epochs), "--width", str(width)]),
-                starts=int(len(ids)), options=int(len(y)), epoch=best_epoch, sensor=sensor,
-                minutes=round((time.perf_counter() - t0) / 60.0, 2), **figures)
+                                  str(out), "--seed", str(seed), "--epochs", str(epochs), "--width", str(width),
+                                  "--members", str(members), *([] if refit else ["--no-refit"])]),
+                starts=int(len(ids)), options=int(len(y)), epoch=best_epoch, members=members, refit=refit,
+                sensor=sensor, minutes=round((time.perf_counter() - t0) / 60.0, 2), **figures)
     save_ranker(out, ranker, skill, sensor, info)
     return info
 
@@ -269,8 +295,11 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("folders", nargs="+", help="collect's --out folders")
     f.add_argument("--out", required=True, help="the ranker file to write")
     f.add_argument("--seed", type=int, default=0)
-    f.add_argument("--epochs", type=int, default=40)
-    f.add_argument("--width", type=int, default=64)
+    f.add_argument("--epochs", type=int, default=20, help="most epochs; the held-out pick chooses (default: 20)")
+    f.add_argument("--width", type=int, default=64, help="hidden units per layer (default: 64)")
+    f.add_argument("--members", type=int, default=5, help="MLPs in the ensemble (default: 5)")
+    f.add_argument("--no-refit", dest="refit", action="store_false",
+                   help="save the chosen epoch's ranker fitted without the held-out starts, not one refitted on all")
     f.add_argument("--json", action="store_true")
     a = sub.add_parser("attach", help="write a frame search that acts on a ranker")
     a.add_argument("skill", choices=PRIMITIVES)
@@ -296,7 +325,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "attach":
             print(f"wrote {attach(args.skill, args.ranker, args.out, args.frames, args.sensor)}")
             return 0
-        info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, progress=not args.json)
+        info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, args.members,
+                   refit=args.refit, progress=not args.json)
     except AffordplanError as exc:
         print(f"{parser.prog}: error: {exc}", file=sys.stderr)
         return 2
@@ -304,8 +334,10 @@ def main(argv: list[str] | None = None) -> int:
         print(json.dumps(info, indent=2))
     else:
         h, r = info["held_out"], info["ratings_held_out"]
+        refitted = ", refitted on every start" if info["refit"] else ""
         print(f"{args.skill} ranker -> {args.out}: {info['starts']} starts, {info['options']} options, epoch "
-              f"{info['epoch']}\n  held-out starts: ranker's pick {h['pick']:.3f} (within-start AUROC "
+              f"{info['epoch']}, {info['members']} members{refitted}\n  held-out starts: ranker's pick "
+              f"{h['pick']:.3f} (within-start AUROC "
               f"{h['within_start_auroc']:.3f}); the search's pick {info['search_pick_held_out']:.3f}; the ratings' "
               f"best {r['pick']:.3f} ({r['within_start_auroc']:.3f}); best option {h['best']:.3f}, random "
               f"{h['random']:.3f}")
