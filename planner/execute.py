@@ -34,13 +34,13 @@ from planner.predict import expected_pose
 from primitives import params as skill_params
 from primitives.params import made_progress
 from primitives.skills import Skill, skills_sensor
-from primitives.strokes import push_to
+from primitives.strokes import MAX_TURN, STOP_WITHIN, push_to
 
 if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its plans
     from planner.plan import Planner
 
-XY_TOL = 0.025  # metres off the plan before replanning
-YAW_TOL = math.radians(12.0)
+XY_TOL = STOP_WITHIN  # metres off the plan before replanning: where a push's strokes stop short of their target
+YAW_TOL = MAX_TURN  # radians off the plan before replanning: the most a push's strokes may turn the object
 
 
 @dataclass

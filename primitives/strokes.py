@@ -28,8 +28,8 @@ if TYPE_CHECKING:
     from primitives.skills import Skill
 
 EXTRA_STROKES = 1  # strokes a call may take beyond its strides (one stroke that fell short)
-STOP_WITHIN = 0.025  # metres from the target at which the strokes stop (the executor's XY_TOL)
-MAX_TURN = math.radians(12.0)  # a stroke that turned the object more than this ends the call (the executor's YAW_TOL)
+STOP_WITHIN = 0.025  # metres from the target at which the strokes stop (the executor replans past it: XY_TOL)
+MAX_TURN = math.radians(12.0)  # turning the object more than this ends the call (the executor's YAW_TOL is it)
 
 
 @dataclass
