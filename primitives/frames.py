@@ -318,8 +318,9 @@ class FrameSearch:
         Path(path).write_text(json.dumps(d, indent=2) + "\n")
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> FrameSearch:
-        """A frame search from a JSON file (raises :class:`InputError` for an unreadable one)."""
+    def load(cls, path: str | os.PathLike, ranked: bool = True) -> FrameSearch:
+        """A frame search from a JSON file (raises :class:`InputError` for an unreadable one). ``ranked=False``:
+        without the ranker it names (neither loaded nor kept), as when a new ranker replaces it."""
         try:
             d = json.loads(Path(path).read_text())
             ranker_file = str(d.get("ranker", ""))
@@ -328,7 +329,7 @@ class FrameSearch:
                          int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
-        if not ranker_file:
+        if not ranker_file or not ranked:
             return search
         if Path(ranker_file).name != ranker_file:
             raise InputError(f"frame search file {path} names its ranker {ranker_file!r}; it must be a file name "
@@ -337,18 +338,23 @@ class FrameSearch:
 
 
 def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None,
-                         sensor: str | None = None, *, trained_on: str | None = None) -> FrameSearch | None:
+                         sensor: str | None = None, *, trained_on: str | None = None,
+                         ranked: bool = True) -> FrameSearch | None:
     """The frame search shipped beside a skill's weights (``{weights_dir}/{name}_frames.json``, by default the
     package's ``weights/``; for ``sensor``'s clouds where one was fitted to them,
-    :func:`primitives.weights_file.rating_path`, ``trained_on`` as there), if any."""
+    :func:`primitives.weights_file.rating_path`, ``trained_on`` as there), if any; ``ranked`` as
+    :meth:`FrameSearch.load`."""
     path = rating_path(name, "frames", sensor, weights_dir, trained_on=trained_on)
-    return FrameSearch.load(path) if path.exists() else None
+    return FrameSearch.load(path, ranked) if path.exists() else None
 
 
-def load_frame_search(skill: str, frames: str | os.PathLike, sensor: str | None = None) -> FrameSearch:
+def load_frame_search(skill: str, frames: str | os.PathLike, sensor: str | None = None,
+                      ranked: bool = True) -> FrameSearch:
     """``"shipped"``: the frame search shipped beside ``skill``'s weights (for ``sensor``'s clouds); else the
-    frames.json at ``frames``. Raises :class:`InputError` where none is shipped or the file is unreadable."""
-    search = shipped_frame_search(skill, sensor=sensor) if str(frames) == "shipped" else FrameSearch.load(frames)
+    frames.json at ``frames``; ``ranked=False``: without its ranker (:meth:`FrameSearch.load`). Raises
+    :class:`InputError` where none is shipped or the file is unreadable."""
+    search = (shipped_frame_search(skill, sensor=sensor, ranked=ranked) if str(frames) == "shipped"
+              else FrameSearch.load(frames, ranked))
     if search is None:
         raise InputError(f"no frame search is shipped for {skill}")
     return search

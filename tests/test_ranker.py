@@ -60,6 +60,12 @@ def test_fit_writes_a_ranker_that_loads_and_says_how_it_was_made(tmp_path):
     assert search.ranker_file == "spin_ranker.pt" and (tmp_path / "cand" / "spin_ranker.pt").exists()
     assert (search.turns, search.mirror, search.platt, search.stand_ins) == (
         shipped.turns, shipped.mirror, shipped.platt, shipped.stand_ins)
+    (tmp_path / "cand" / "spin_ranker.pt").write_bytes(b"damaged")  # a search whose own ranker no longer loads
+    with pytest.raises(Exception, match="spin_ranker"):
+        FrameSearch.load(frames)
+    assert FrameSearch.load(frames, ranked=False).ranker is None
+    again = attach("spin", tmp_path / "spin_ranker.pt", tmp_path / "again", frames=str(frames))  # replaced, not read
+    assert FrameSearch.load(again).ranker is not None
     with pytest.raises(Exception, match="push"):
         attach("push", tmp_path / "spin_ranker.pt", tmp_path / "other")
     assert not (tmp_path / "other").exists()

@@ -263,7 +263,7 @@ def attach(skill: str, ranker: str | Path, out: str | Path, frames: str = "shipp
     """Write ``frames`` (``"shipped"``: the shipped frame search for ``sensor``'s clouds, or a frames.json path)
     acting on ``ranker`` into the folder ``out`` (module docstring); returns the frames file written."""
     load_ranker(ranker, skill)  # refuses a file that is not a ranker for skill before anything is written
-    search = load_frame_search(skill, frames, sensor)
+    search = load_frame_search(skill, frames, sensor, ranked=False)  # the ranker it names, if any, is replaced
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     name = f"{skill}_ranker.pt"
