@@ -20,6 +20,7 @@ def test_collect_executes_every_option_and_resumes_where_it_stopped(tmp_path):
         m = rows["start"] == s
         assert rows["chosen"][m].sum() == 1 and rows["parameterised"][m].all() and not rows["stand_in"][m].any()
         assert np.ptp(rows["extents"][m], axis=0).max() == 0.0
+        assert len(set(rows["object"][m])) == 1 and rows["object"][m][0]  # the start's object, by its key
     first = (tmp_path / "c" / "chunk_0001.npz").read_bytes()
     (tmp_path / "c" / "chunk_0001.npz").unlink()  # killed before its last chunk was written
     collect("spin", tmp_path / "c", starts=3, params="random", chunk=2, progress=False)

@@ -8,7 +8,8 @@
 **collect** draws stable starts of training objects (``--objects``, never held-out ones) and, for each, executes
 the policy in *every* option the frame search rates (each free frame of the request and of each stand-in request,
 :meth:`primitives.frames.FrameSearch.options`), restoring the simulator to the start before each. It records per
-option what the ranker reads (:func:`primitives.option_ranker.option_features`' inputs) and whether it succeeded.
+option what the ranker reads (:func:`primitives.option_ranker.option_features`' inputs), whether it succeeded,
+and the start's object (its catalogue key; empty in chunks collected before it was recorded).
 Starts come in chunks of ``--chunk``, each from an environment seeded by ``(seed, chunk)`` and written to its own
 ``chunk_NNNN.npz`` when done: a collection killed at any moment resumes at its first missing chunk, and gives the
 same data as one never stopped.
@@ -58,13 +59,14 @@ from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_o
 from primitives.training.evaluate import load_policy
 from primitives.training.success import SuccessModel, auroc, load_success_net
 
-COLUMNS = ("start", "decision", "rating", "request", "parameterised", "stand_in", "extents", "success", "chosen")
+COLUMNS = ("start", "object", "decision", "rating", "request", "parameterised", "stand_in", "extents", "success",
+           "chosen")
 
 
 def start_rows(env: PrimitiveEnv, model: SuccessModel, search: FrameSearch) -> dict[str, np.ndarray]:
     """Every option of ``env``'s current start executed from it (the start restored before each and after the
-    last): the per-option columns of :data:`COLUMNS` but ``start``. ``chosen`` marks the option the search without
-    a ranker acts in."""
+    last): the per-option columns of :data:`COLUMNS` but ``start`` and ``object``. ``chosen`` marks the option the
+    search without a ranker acts in."""
     skill, sim, seen = env.config.primitive, env.sim, env.seen
     start = sim.snapshot()
     options = search.options(skill, seen, sim)
@@ -124,6 +126,7 @@ def collect(skill: str, out: str | Path, starts: int, params: str = "none", obje
             for key, value in got.items():
                 rows[key].append(value)
             rows["start"].append(np.full(len(got["success"]), s))
+            rows["object"].append(np.full(len(got["success"]), str(env.object_key)))
             bar.update(1)
         env.close()
         tmp = path.with_name(path.name + ".tmp")  # not chunk_*.npz: a write killed half-way is never read
@@ -155,7 +158,10 @@ def read_collections(skill: str, folders: list[str | Path]) -> tuple[dict[str, n
                     raise InputError(f"{path} holds {meta['skill']} options, not {skill}")
                 sensors.add(meta["sensor"])
                 for key in COLUMNS:
-                    rows[key].append(d[key] + offset if key == "start" else d[key])
+                    if key == "object" and key not in d.files:  # chunks collected before objects were recorded
+                        rows[key].append(np.full(len(d["start"]), ""))
+                    else:
+                        rows[key].append(d[key] + offset if key == "start" else d[key])
         offset = int(max(r.max() for r in rows["start"])) + 1
     if len(sensors) != 1:
         raise InputError(f"the collections mix sensors ({', '.join(sorted(sensors))}); fit one ranker per sensor")
