@@ -98,9 +98,13 @@ class OptionRanker(nn.Module):
     def width(self) -> int:
         return self.nets[0][0].out_features
 
+    def standardise(self, features: torch.Tensor) -> torch.Tensor:
+        """Features ``(m, N_FEATURES)`` as every member reads them: less ``mean``, over ``scale``."""
+        return (features - self.mean) / self.scale
+
     def member_logits(self, features: torch.Tensor) -> torch.Tensor:
         """Each member's logits ``(members, m)`` of features ``(m, N_FEATURES)``."""
-        z = (features - self.mean) / self.scale
+        z = self.standardise(features)
         return torch.stack([net(z).squeeze(-1) for net in self.nets])
 
     def forward(self, features: torch.Tensor) -> torch.Tensor:

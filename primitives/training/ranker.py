@@ -203,7 +203,7 @@ def _train(x: np.ndarray, y: np.ndarray, epochs: int, width: int, members: int, 
     ranker = OptionRanker(width, members)
     ranker.mean.copy_(torch.from_numpy(x.mean(axis=0)))
     ranker.scale.copy_(torch.from_numpy(x.std(axis=0) + 1e-6))
-    xt, yt = (torch.from_numpy(x) - ranker.mean) / ranker.scale, torch.from_numpy(y)
+    xt, yt = ranker.standardise(torch.from_numpy(x)), torch.from_numpy(y)  # once, not per batch
     opts = [torch.optim.AdamW(net.parameters(), lr=1e-3, weight_decay=weight_decay) for net in ranker.nets]
     loss_fn = nn.BCEWithLogitsLoss()
     judged = []
