@@ -42,12 +42,12 @@ from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
 from primitives.training.env import PRIMITIVES, PrimitiveEnv
 from primitives.training.evaluate import (
-    greedy_action,
     held_out_config,
     load_policy,
     named_objects_config,
     object_list,
 )
+from primitives.training.options import execute_every_option
 from primitives.training.success import SuccessModel, auroc, load_success_net
 
 
@@ -139,34 +139,19 @@ class FrameCeiling:
         plt.close(fig)
 
 
-@torch.no_grad()
 def start_options(env: PrimitiveEnv, policy: HybridActorCritic, search: FrameSearch,
                   rater: SuccessModel) -> StartOptions:
-    """Execute every option of ``search`` on ``env``'s current start, restoring the start before each (and after
-    the last); ``rater`` rates the options (and gives the policy's decisions to a ranker)."""
-    skill, sim, seen = env.config.primitive, env.sim, env.seen
-    start = sim.snapshot()
-    options = search.options(skill, seen, sim)
-    ratings, decision = search.rate_and_decide(options, rater.rate_and_decide)
-    ranking = search.rank(skill, options, ratings, decision) if search.ranks(seen.params) else None
-    k_pick, j_pick, _ = search.choose(options, ratings, ranking)
-    option, frame, q_max, success = [], [], [], []
-    for k, (_, frames) in enumerate(options):
-        for j in range(len(frames)):
-            sim.restore(start)
-            env.seen = search.acting(options, k, j)
-            idx, motion, q = greedy_action(policy, env.seen.obs)
-            success.append(env.step(idx, motion).success)
-            option.append(k), frame.append(j), q_max.append(float(q[idx]))
-    sim.restore(start)
-    env.seen = seen
-    option, frame = np.array(option), np.array(frame)
-    parameterised = np.array([options[k][0].params is not None for k in option])
-    pick = int(np.flatnonzero((option == k_pick) & (frame == j_pick))[0])
+    """Execute every option of ``search`` on ``env``'s current start (:func:`execute_every_option`); ``rater``
+    rates the options (and gives the policy's decisions to a ranker)."""
+    skill, seen = env.config.primitive, env.seen
+    done = execute_every_option(env, policy, search)
+    ratings, decision = search.rate_and_decide(done.options, rater.rate_and_decide)
+    ranking = search.rank(skill, done.options, ratings, decision) if search.ranks(seen.params) else None
+    k_pick, j_pick, _ = search.choose(done.options, ratings, ranking)
     compared = (np.concatenate(ranking) if ranking is not None
-                else search.calibrate_kind(np.concatenate(ratings), parameterised))
-    return StartOptions(seen.params, option, frame, compared,
-                        np.array(q_max), np.array(success, dtype=bool), pick)
+                else search.calibrate_kind(np.concatenate(ratings), done.parameterised))
+    return StartOptions(seen.params, done.option, done.frame, compared, done.decision[:, 0].astype(float),
+                        done.success, done.row(k_pick, j_pick))
 
 
 def frame_ceiling(skill: str, starts: int = 100, params: str = "random", seed: int = 1234,

@@ -54,9 +54,9 @@ from primitives.option_ranker import (
     request_size,
     save_ranker,
 )
-from primitives.success_model import decision_features
 from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.evaluate import load_policy
+from primitives.training.options import execute_every_option
 from primitives.training.success import SuccessModel, auroc, load_success_net
 
 COLUMNS = ("start", "object", "decision", "rating", "request", "parameterised", "stand_in", "extents", "success",
@@ -64,34 +64,19 @@ COLUMNS = ("start", "object", "decision", "rating", "request", "parameterised", 
 
 
 def start_rows(env: PrimitiveEnv, model: SuccessModel, search: FrameSearch) -> dict[str, np.ndarray]:
-    """Every option of ``env``'s current start executed from it (the start restored before each and after the
-    last): the per-option columns of :data:`COLUMNS` but ``start`` and ``object``. ``chosen`` marks the option the
-    search without a ranker acts in."""
-    skill, sim, seen = env.config.primitive, env.sim, env.seen
-    start = sim.snapshot()
-    options = search.options(skill, seen, sim)
-    ratings = search.rate(options, model.predict)
-    k_pick, j_pick, _ = search.choose(options, ratings)
-    acting = [(k, j, search.acting(options, k, j)) for k, (_, frames) in enumerate(options)
-              for j in range(len(frames))]
-    with torch.no_grad():
-        index, motion, decision = decision_features(model.policy, torch.from_numpy(
-            np.stack([a.obs for _, _, a in acting]).astype(np.float32)))
-    success = []
-    for n, (_, _, a) in enumerate(acting):
-        sim.restore(start)
-        env.seen = a
-        success.append(env.step(int(index[n]), motion[n].numpy().astype(np.float64)).success)
-    sim.restore(start)
-    env.seen = seen
-    m = len(acting)
-    return dict(decision=decision.numpy(), rating=np.concatenate(ratings),
-                request=np.array([request_size(skill, options[k][0].params) for k, _, _ in acting]),
-                parameterised=np.array([options[k][0].params is not None for k, _, _ in acting]),
-                stand_in=np.array([k > 0 for k, _, _ in acting]),
-                extents=np.tile(cloud_extents(seen.obs[:, :3]), (m, 1)),
-                success=np.array(success, dtype=bool),
-                chosen=np.array([(k, j) == (k_pick, j_pick) for k, j, _ in acting]))
+    """Every option of ``env``'s current start executed from it (:func:`execute_every_option`): the per-option
+    columns of :data:`COLUMNS` but ``start`` and ``object``. ``chosen`` marks the option the search without a
+    ranker acts in."""
+    skill, seen = env.config.primitive, env.seen
+    done = execute_every_option(env, model.policy, search)
+    ratings = search.rate(done.options, model.predict)
+    chosen = np.zeros(len(done), dtype=bool)
+    chosen[done.row(*search.choose(done.options, ratings)[:2])] = True
+    return dict(decision=done.decision, rating=np.concatenate(ratings),
+                request=np.array([request_size(skill, done.options[k][0].params) for k in done.option]),
+                parameterised=done.parameterised, stand_in=done.option > 0,
+                extents=np.tile(cloud_extents(seen.obs[:, :3]), (len(done), 1)),
+                success=done.success, chosen=chosen)
 
 
 def collect(skill: str, out: str | Path, starts: int, params: str = "none", objects: str = "train+housekeep:training",
