@@ -440,3 +440,30 @@ def test_single_training_meshes_are_not_held_out():
     name = housekeep.names("training")[0]
     assert not held_out(f"housekeep/{name}") and not held_out("cube") and not held_out(f"meshes/{name}.obj")
     check_objects(f"train+housekeep/{name}", fitting=True)
+
+
+def test_searched_rollouts_act_with_the_frame_search_and_ratings_of_the_asked_sensor(tmp_path, monkeypatch):
+    """``train --frames shipped --sensor cameras`` collects with the camera frame search (spin's: ranked) and
+    the success model for camera clouds, as the skill acts on a camera simulator, not with the files beside the
+    policy."""
+    asked, real_search = {}, success.load_frame_search
+
+    class Stop(Exception):
+        pass
+
+    def frame_search(skill, frames, sensor=None, ranked=True):
+        asked["frames"] = sensor
+        search = real_search(skill, frames, sensor, ranked)
+        asked["ranked"] = search.ranker is not None
+        return search
+
+    def success_net(skill, weights=None, sensor=None):
+        asked["model"] = sensor
+        raise Stop  # before any rollout
+
+    monkeypatch.setattr(success, "load_frame_search", frame_search)
+    monkeypatch.setattr(success, "load_success_net", success_net)
+    with pytest.raises(Stop):
+        success.main(["train", "spin", "--frames", "shipped", "--sensor", "cameras", "--rollouts", "1",
+                      "--out", str(tmp_path)])
+    assert asked == {"frames": "cameras", "ranked": True, "model": "cameras"}

@@ -728,7 +728,7 @@ def _run(args: argparse.Namespace) -> int:
     policy = load_policy(args.policy, args.skill)
     if args.command == "train":
         searched = args.frames is not None
-        search = load_frame_search(args.skill, args.frames) if searched else None
+        search = load_frame_search(args.skill, args.frames, sensor=args.sensor) if searched else None
         workers = f"_w{args.workers}" if args.workers > 1 else ""
         stand_ins = f"s{args.contrast_stand_ins}" if args.contrast_stand_ins else ""
         stand_ins += "n" if args.neighbours else ""
@@ -744,7 +744,7 @@ def _run(args: argparse.Namespace) -> int:
                 progress=not args.json, search=contrast, per_start=args.contrast, split=args.objects,
                 neighbours=args.neighbours, sensor=args.sensor))
         elif searched:
-            rater = SuccessModel(policy, load_success_net(args.skill, args.model))
+            rater = SuccessModel(policy, load_success_net(args.skill, args.model, sensor=args.sensor))
             data = Rollouts.concat([part[1] for part in collect_parallel(
                 collect_frame_search, (rater, args.skill), args.rollouts, args.seed, args.workers,
                 progress=not args.json, search=search, split=args.objects, sensor=args.sensor)])
