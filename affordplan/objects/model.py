@@ -100,8 +100,12 @@ class ObjectModel:
         """
         key = (int(n), int(seed))
         if key not in self._samples:
-            points, face_idx = trimesh.sample.sample_surface_even(self.mesh, n, seed=seed)
-            if len(points) < n:  # sample_surface_even may return fewer; top up uniformly
+            # trimesh.sample.sample_surface_even's own steps (3n uniform samples, those closer than its radius
+            # dropped), without the warning it logs when fewer than n are left: those are topped up below
+            points, face_idx = trimesh.sample.sample_surface(self.mesh, 3 * n, seed=seed)
+            points, keep = trimesh.points.remove_close(points, np.sqrt(self.mesh.area / (3 * n)))
+            points, face_idx = points[:n], face_idx[keep][:n]
+            if len(points) < n:  # fewer than n far enough apart: top up uniformly
                 extra, extra_idx = trimesh.sample.sample_surface(self.mesh, n - len(points), seed=seed)
                 points = np.vstack([points, extra])
                 face_idx = np.concatenate([face_idx, extra_idx])
