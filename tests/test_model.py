@@ -136,8 +136,6 @@ def test_bad_size_raises():
         ap.load_object("cube", size=-1.0)
 
 
-
-
 def test_surface_samples_fill_their_count_without_trimesh_warnings(caplog):
     """A mesh whose even sampling falls short (2 mm-spaced rejection leaves ~7,300 of 8,192 on this donut) still gets
     all n points, on its surface, with unit normals, and trimesh's "only got" warning is not logged."""

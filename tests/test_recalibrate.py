@@ -11,7 +11,8 @@ from primitives.training import recalibrate
 from primitives.training.success import Rollouts
 
 
-def _rollouts(net: SuccessNet, n: int, objects: int, spread: float, offset: float, seed: int) -> Rollouts:
+def _rollouts(net: SuccessNet, n: int, objects: int, spread: float, offset: float,
+              seed: int) -> tuple[Rollouts, float]:
     """``n`` rollouts of ``objects`` objects whose outcomes follow ``sigmoid(a z + offset)`` of ``net``'s raw logit
     ``z``, with ``a`` set so that ``a z`` spreads by ``spread`` (one standard deviation); returns them and ``a``."""
     rng = np.random.default_rng(seed)

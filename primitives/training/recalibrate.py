@@ -64,27 +64,25 @@ def recalibrate(net: SuccessNet, data: Rollouts) -> Recalibration:
     """Refit ``net``'s Platt scaling on ``data`` (module docstring); ``net`` is left unchanged.
 
     Raises:
-        ValueError: rollouts of fewer than :data:`MIN_OBJECTS` objects.
+        InputError: rollouts of fewer than :data:`MIN_OBJECTS` objects.
     """
     groups = np.unique(data.group)
     if len(groups) < MIN_OBJECTS:
-        raise ValueError(f"recalibrating needs rollouts of at least {MIN_OBJECTS} objects, got {len(groups)}")
+        raise InputError(f"recalibrating needs rollouts of at least {MIN_OBJECTS} objects, got {len(groups)}")
     with torch.no_grad():
         obs, decision = torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)
-        z = net.logit(obs, decision)
-        before = net(obs, decision).numpy()
+        z = net.logit(obs, decision)  # the ensemble once; each scaling below is applied to these logits
     y = torch.from_numpy(data.success.astype(np.float32))
 
-    def scaled(ab: torch.Tensor, mask: np.ndarray) -> np.ndarray:
-        return torch.sigmoid(ab[0] * z[mask] + ab[1]).numpy()
+    def scaled(ab: torch.Tensor, z: torch.Tensor) -> np.ndarray:
+        return torch.sigmoid(ab[0] * z + ab[1]).numpy()
 
     ab = _platt(z, y)
     loo = np.zeros(len(data), dtype=np.float32)
     for g in groups:
-        held = data.group == g
-        loo[held] = scaled(_platt(z[~held], y[~held]), held)
-    everything = np.ones(len(data), dtype=bool)
-    return Recalibration((float(ab[0]), float(ab[1])), before, scaled(ab, everything), loo)
+        held = torch.from_numpy(data.group == g)
+        loo[held.numpy()] = scaled(_platt(z[~held], y[~held]), z[held])
+    return Recalibration((float(ab[0]), float(ab[1])), scaled(net.platt, z), scaled(ab, z), loo)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -132,7 +130,6 @@ def run(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    policy = load_policy(args.policy, args.skill)
     searched_path = Path(args.searched) if args.searched else weights_file.rating_path(args.skill, "searched",
                                                                                           args.sensor)
     net = load_success_net(args.skill, searched_path)
@@ -140,15 +137,13 @@ def run(args: argparse.Namespace) -> int:
     if cache.exists():  # a run killed after collecting resumes here
         data = Rollouts.load(cache)
     else:
-        rater = SuccessModel(policy, load_success_net(args.skill, None, sensor=args.sensor))
+        rater = SuccessModel(load_policy(args.policy, args.skill),
+                             load_success_net(args.skill, None, sensor=args.sensor))
         search = load_frame_search(args.skill, args.frames, sensor=args.sensor)
         _, data = collect_frame_search(rater, args.skill, args.rollouts, search, args.objects, n_objects=200,
                                        seed=args.seed, progress=not args.json, sensor=args.sensor)
         data.save(cache)
-    try:
-        result = recalibrate(net, data)
-    except ValueError as exc:
-        raise InputError(f"--objects {args.objects}: {exc}") from None
+    result = recalibrate(net, data)
     platt_before = [float(v) for v in net.platt]
     net.platt.copy_(torch.tensor(result.platt))
     info = dict(skill=args.skill, sensor=args.sensor, objects=args.objects, rollouts=len(data), seed=args.seed,
@@ -164,7 +159,6 @@ def run(args: argparse.Namespace) -> int:
     (out / "calibrate.json").write_text(json.dumps(info, indent=2))
     print(json.dumps(info, indent=2))
     return 0
-
 
 
 if __name__ == "__main__":
