@@ -3,12 +3,16 @@
     python -m primitives.evaluate push --weights runs/push/policy.pt --trials 200 --objects random
     python -m primitives.evaluate push --objects seed7 --plot fig5_push.png --json
     python -m primitives.evaluate push --critic-map critic_map.png
+    python -m primitives.evaluate spin --params random --frames shipped --strokes 4 --objects housekeep:unseen
 
 Protocol (the seed's Section IV): each trial starts the object in a stable pose (a resting state
 drawn by its probability, a random position in the middle of the workspace and a random yaw), the
 policy acts greedily (argmax of the critic map, the actor's motion without noise), and success is the
 seed's criterion for that primitive. ``--objects random`` uses the held-out procedural split (never
 trained on); ``seed7`` the seed's seven objects (``--trials`` each); paths evaluate mesh files.
+``--strokes K`` (spin and roll, with ``--params random``) lets each trial be one call of up to K strokes of
+the skill re-observing between them (:func:`primitives.strokes.spin_by`, :func:`~primitives.strokes.roll_to`),
+the skill acting as a user's call acts, and reports success within 1..K strokes.
 """
 
 from __future__ import annotations
@@ -23,12 +27,13 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError
+from affordplan.errors import AffordplanError, InputError
 from affordplan.log import cli_logging
 from affordplan.objects import housekeep
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
 from primitives.policy import greedy_action, load_policy  # noqa: F401  (re-exported: older imports)
+from primitives.skills import Skill, load_skill
 from primitives.training.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
 
 # The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
@@ -52,6 +57,16 @@ class EvalResult:
     outcomes: list[bool] = field(default_factory=list)  # every trial's success, in order
     acted_as: list[dict | None] = field(default_factory=list)  # each trial's stand-in request (frame search only)
     sensor: str = "cameras"
+    strokes: list[int] = field(default_factory=list)  # each trial's strokes (calls of several strokes only)
+
+    def within(self) -> dict[int, float]:
+        """Success within 1..K strokes (calls of up to K strokes; a call stops where it meets its criterion, so one
+        of up to k strokes is this call's first k)."""
+        if not self.strokes:
+            return {}
+        done = np.array(self.outcomes, dtype=bool)
+        used = np.array(self.strokes)
+        return {k: float(np.mean(done & (used <= k))) for k in range(1, int(used.max()) + 1)}
 
     @property
     def success_rate(self) -> float:
@@ -79,6 +94,8 @@ class EvalResult:
         if any(stand_ins):
             out.update(stand_in_share=float(np.mean(stand_ins)),
                        stand_in_success=float(np.mean([o for o, a in zip(self.outcomes, stand_ins) if a])))
+        if self.strokes:
+            out.update(mean_strokes=float(np.mean(self.strokes)), success_within=self.within())
         return out
 
 
@@ -170,6 +187,38 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
         name = "random" if key is None else str(key)
         result.per_object.setdefault(name, []).append(res.success)
         result.outcomes.append(bool(res.success))
+    env.close()
+    return result
+
+
+def evaluate_strokes(skill: Skill, objects: str | tuple[str, ...] = "random", trials: int = 200, seed: int = 1234,
+                     max_strokes: int = 4, progress: bool = True, sensor: str = "cameras") -> EvalResult:
+    """Success of calls of up to ``max_strokes`` strokes (:func:`primitives.strokes.spin_by` for the spin,
+    :func:`~primitives.strokes.roll_to` for the roll) on the starts and asked parameters :func:`evaluate` draws
+    with ``p_params=1`` (same ``seed``: same starts), ``skill`` acting as a user's call acts (its frame search and
+    ratings for ``sensor``'s clouds). Judged by each call's criterion, the asked parameter's."""
+    from primitives.strokes import roll_to, spin_by
+
+    if skill.name not in ("spin", "roll"):
+        raise InputError(f"calls of several strokes are spin_by and roll_to; {skill.name} has none")
+    cfg = held_out_config(skill.name, 1.0, sensor) if objects == "random" else \
+        named_objects_config(skill.name, object_list(objects), 1.0, sensor)
+    plan = [None] * trials if objects == "random" else [n for n in object_list(objects) for _ in range(trials)]
+    env = PrimitiveEnv(cfg, seed=seed)
+    result = EvalResult(skill.name, objects if isinstance(objects, str) else "paths", sensor=sensor, params="random",
+                        frames=f"calls of up to {max_strokes} strokes")
+    for key in tqdm(plan, desc=f"evaluate {skill.name} x{max_strokes}", disable=not progress, unit="trial",
+                    mininterval=2.0):
+        env.reset(object_key=key)
+        asked = env.params
+        if skill.name == "spin":
+            made = spin_by(skill, env.sim, asked["angle"], max_strokes)
+        else:
+            made = roll_to(skill, env.sim, asked["target"], max_strokes)
+        result.invalid += not made.outcome.valid
+        result.per_object.setdefault("random" if key is None else str(key), []).append(bool(made.outcome.success))
+        result.outcomes.append(bool(made.outcome.success))
+        result.strokes.append(made.strokes)
     env.close()
     return result
 
@@ -269,6 +318,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="an uncalibrated frame search over N turns, where the request leaves the turn free")
     p.add_argument("--frame-mirror", action="store_true",
                    help="with --frame-turns: also the mirrored frames, where the request leaves the mirror free")
+    p.add_argument("--strokes", type=int, default=1, metavar="K",
+                   help="spin or roll with --params random: each trial one call of up to K strokes re-observing "
+                        "between them (primitives.strokes), the skill as a user's call has it (with --frames shipped: "
+                        "the shipped skill); default 1: the one-stroke protocol")
     p.add_argument("--success-weights", default=None, help="success model for the frame search (default: shipped)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--plot", default=None, help="write bar charts (the seed's Fig. 3 / Fig. 5) here")
@@ -294,17 +347,51 @@ def _frame_search(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     return None
 
 
+def _main_strokes(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """``main`` for ``--strokes K``: calls of several strokes of the skill (:func:`evaluate_strokes`)."""
+    search = _frame_search(args, parser)
+    if args.frames == "shipped" and args.weights is None and args.success_weights is None:
+        skill = load_skill(args.primitive)  # the shipped skill, exactly as a user's load_skill gives it
+    else:
+        skill = load_skill(args.primitive, args.weights, args.success_weights,
+                           frame_search=search if search is not None else False)
+    objects = _objects(args)
+    result = evaluate_strokes(skill, objects, args.trials, args.seed, args.strokes, progress=not args.json,
+                              sensor=args.sensor)
+    if args.json:
+        print(json.dumps(result.as_dict(), indent=2))
+        return 0
+    print(f"{args.primitive} (asked parameters, calls of up to {args.strokes} strokes): success "
+          f"{result.success_rate:.3f} over {len(result.outcomes)} trials ({result.invalid} invalid), "
+          f"{np.mean(result.strokes):.2f} strokes a call")
+    print("  within " + ", ".join(f"{k} stroke{'s' * (k > 1)}: {v:.3f}" for k, v in result.within().items()))
+    for name, rate in result.rates().items():
+        print(f"  {name:14s} {rate:.3f}")
+    return 0
+
+
+def _objects(args: argparse.Namespace) -> str | tuple[str, ...]:
+    """``--objects`` as :func:`evaluate` takes it: one set (``random``, ``seed7``, ``housekeep:SPLIT``) or names."""
+    one = args.objects[0]
+    return one if len(args.objects) == 1 and (":" in one or one in ("random", "seed7")) else tuple(args.objects)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     cli_logging()
     if args.trials < 1:
         parser.error(f"--trials must be a positive integer, got {args.trials}")
+    if args.strokes != 1 and (args.params != "random" or args.primitive == "push" or args.plot or args.critic_map):
+        parser.error("--strokes takes spin or roll with --params random (and neither --plot nor --critic-map)")
+    if not 1 <= args.strokes <= 20:
+        parser.error(f"--strokes must be from 1 to 20, got {args.strokes}")
     torch.set_num_threads(1)
     try:
+        if args.strokes != 1:
+            return _main_strokes(args, parser)
         model = load_policy(args.weights, args.primitive)
-        objects = args.objects[0] if len(args.objects) == 1 and ":" in args.objects[0] or args.objects[0] in (
-            "random", "seed7") else tuple(args.objects)
+        objects = _objects(args)
         search = _frame_search(args, parser)
         result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
                           p_params=1.0 if args.params == "random" else 0.0, frame_search=search,
