@@ -1,5 +1,5 @@
 """Evaluation of a policy (primitives.training.evaluate): deterministic figures and greedy actions, what a result
-reports, the objects an evaluation names."""
+reports, calls of several strokes, the objects an evaluation names."""
 
 from __future__ import annotations
 
@@ -7,9 +7,19 @@ import numpy as np
 import pytest
 import torch
 
+from affordplan.errors import InputError
 from primitives.networks import HybridActorCritic
+from primitives.skills import load_skill
 from primitives.training.env import SEED_SEVEN, EnvConfig, PrimitiveEnv
-from primitives.training.evaluate import EvalResult, evaluate, greedy_action, object_list, seed_reference
+from primitives.training.evaluate import (
+    EvalResult,
+    evaluate,
+    evaluate_strokes,
+    greedy_action,
+    main,
+    object_list,
+    seed_reference,
+)
 
 
 def test_evaluation_is_deterministic():
@@ -45,3 +55,29 @@ def test_the_seed_objects_and_their_real_counterparts_are_named_for_evaluation()
     assert len(real) == 7 and all(name.startswith("housekeep/") for name in real)
     assert [seed_reference(name) for name in real] == [seed_reference(name) for name in SEED_SEVEN]
     assert seed_reference("cube") is not None and seed_reference("teapot") is None
+
+
+def test_calls_of_several_strokes_report_success_within_each_number_of_strokes():
+    spin = load_skill("spin")
+    made = evaluate_strokes(spin, ("cube",), trials=6, seed=3, max_strokes=3, progress=False)
+    again = evaluate_strokes(spin, ("cube",), trials=6, seed=3, max_strokes=3, progress=False)
+    assert made.outcomes == again.outcomes and made.strokes == again.strokes  # deterministic
+    assert len(made.strokes) == 6 and all(1 <= n <= 3 for n in made.strokes)
+    within = made.within()
+    assert list(within) == list(range(1, max(made.strokes) + 1))
+    assert all(a <= b for a, b in zip(list(within.values()), list(within.values())[1:]))
+    assert within[max(made.strokes)] == made.success_rate
+    d = made.as_dict()
+    assert sum(d["stopped"].values()) == 6 and d["mean_strokes"] == pytest.approx(np.mean(made.strokes))
+    # a call that stopped short of its strokes stopped for a reason other than running out of them
+    assert all(r != "strokes spent" for r, n in zip(made.stopped, made.strokes) if n < 3)
+
+
+def test_several_strokes_are_refused_where_there_is_no_such_call(capsys):
+    for argv in (["push", "--params", "random", "--strokes", "3"], ["spin", "--strokes", "3"],
+                 ["spin", "--params", "random", "--strokes", "0"]):
+        with pytest.raises(SystemExit) as exit_:
+            main(argv)
+        assert exit_.value.code == 2
+    with pytest.raises(InputError, match="spin_by and roll_to"):
+        evaluate_strokes(load_skill("push"), ("cube",), trials=1)

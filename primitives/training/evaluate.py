@@ -58,6 +58,7 @@ class EvalResult:
     acted_as: list[dict | None] = field(default_factory=list)  # each trial's stand-in request (frame search only)
     sensor: str = "cameras"
     strokes: list[int] = field(default_factory=list)  # each trial's strokes (calls of several strokes only)
+    stopped: list[str] = field(default_factory=list)  # why each such call stopped (primitives.strokes.Strokes)
 
     def within(self) -> dict[int, float]:
         """Success within 1..K strokes (calls of up to K strokes; a call stops where it meets its criterion, so one
@@ -95,7 +96,9 @@ class EvalResult:
             out.update(stand_in_share=float(np.mean(stand_ins)),
                        stand_in_success=float(np.mean([o for o, a in zip(self.outcomes, stand_ins) if a])))
         if self.strokes:
-            out.update(mean_strokes=float(np.mean(self.strokes)), success_within=self.within())
+            reasons = [r.split(" (")[0].split(":")[0].rstrip("0123456789 ") for r in self.stopped]  # no details
+            out.update(mean_strokes=float(np.mean(self.strokes)), success_within=self.within(),
+                       stopped={r: reasons.count(r) for r in sorted(set(reasons), key=reasons.index)})
         return out
 
 
@@ -219,6 +222,7 @@ def evaluate_strokes(skill: Skill, objects: str | tuple[str, ...] = "random", tr
         result.per_object.setdefault("random" if key is None else str(key), []).append(bool(made.outcome.success))
         result.outcomes.append(bool(made.outcome.success))
         result.strokes.append(made.strokes)
+        result.stopped.append(made.stopped)
     env.close()
     return result
 
@@ -365,6 +369,7 @@ def _main_strokes(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
           f"{result.success_rate:.3f} over {len(result.outcomes)} trials ({result.invalid} invalid), "
           f"{np.mean(result.strokes):.2f} strokes a call")
     print("  within " + ", ".join(f"{k} stroke{'s' * (k > 1)}: {v:.3f}" for k, v in result.within().items()))
+    print("  calls stopped: " + ", ".join(f"{r} {n}" for r, n in result.as_dict()["stopped"].items()))
     for name, rate in result.rates().items():
         print(f"  {name:14s} {rate:.3f}")
     return 0
