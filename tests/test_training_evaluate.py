@@ -81,3 +81,11 @@ def test_several_strokes_are_refused_where_there_is_no_such_call(capsys):
         assert exit_.value.code == 2
     with pytest.raises(InputError, match="spin_by and roll_to"):
         evaluate_strokes(load_skill("push"), ("cube",), trials=1)
+
+
+def test_a_start_with_nothing_to_ask_is_one_stroke_of_the_seed_objective(monkeypatch):
+    import primitives.params as skill_params
+
+    monkeypatch.setattr(skill_params, "sample", lambda *args, **kwargs: None)  # as from a state with no neighbour
+    made = evaluate_strokes(load_skill("roll"), ("cube",), trials=2, seed=3, max_strokes=3, progress=False)
+    assert made.strokes == [1, 1] and all(r.startswith("no parameter") for r in made.stopped)

@@ -199,8 +199,10 @@ def evaluate_strokes(skill: Skill, objects: str | tuple[str, ...] = "random", tr
     """Success of calls of up to ``max_strokes`` strokes (:func:`primitives.strokes.spin_by` for the spin,
     :func:`~primitives.strokes.roll_to` for the roll) on the starts and asked parameters :func:`evaluate` draws
     with ``p_params=1`` (same ``seed``: same starts), ``skill`` acting as a user's call acts (its frame search and
-    ratings for ``sensor``'s clouds). Judged by each call's criterion, the asked parameter's."""
-    from primitives.strokes import roll_to, spin_by
+    ratings for ``sensor``'s clouds). Judged by each call's criterion, the asked parameter's; a start with nothing to
+    ask (a roll from a state with no state one roll away) is one stroke of the seed's objective, as :func:`evaluate`
+    judges it."""
+    from primitives.strokes import Strokes, roll_to, spin_by
 
     if skill.name not in ("spin", "roll"):
         raise InputError(f"calls of several strokes are spin_by and roll_to; {skill.name} has none")
@@ -214,7 +216,9 @@ def evaluate_strokes(skill: Skill, objects: str | tuple[str, ...] = "random", tr
                     mininterval=2.0):
         env.reset(object_key=key)
         asked = env.params
-        if skill.name == "spin":
+        if asked is None:  # no state one roll away: one stroke of the seed's objective, as evaluate() judges it
+            made = Strokes(skill.execute(env.sim, None), 1, "no parameter to ask (the seed's objective)")
+        elif skill.name == "spin":
             made = spin_by(skill, env.sim, asked["angle"], max_strokes)
         else:
             made = roll_to(skill, env.sim, asked["target"], max_strokes)
