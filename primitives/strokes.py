@@ -28,8 +28,11 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from affordplan.checks import as_finite, as_vector, as_whole
 from affordplan.errors import AffordplanError, InputError
@@ -58,6 +61,41 @@ class Strokes:
     stopped: str
 
 
+def _make_strokes(skill: Skill, sim: Simulator, max_strokes: int, ask: Callable[[], dict[str, float]],
+                  stop: Callable[[Outcome], str | None]) -> tuple[Outcome, Outcome, int, str]:
+    """Up to ``max_strokes`` strokes of ``skill`` in ``sim``, each with the parameter ``ask()`` gives just before it;
+    after each valid stroke ``stop(outcome)`` says why the call ends there (``None``: go on).
+
+    An invalid stroke ends the call. An error in a later stroke (no contact the arm can reach) ends it with the
+    strokes made; in the first, it is raised. Returns the first and last strokes' outcomes, the strokes made and
+    why they stopped."""
+    first: Outcome | None = None
+    last: Outcome | None = None
+    for n in range(1, max_strokes + 1):
+        try:
+            stroke = skill.execute(sim, ask())
+        except AffordplanError as exc:
+            if first is None or last is None:
+                raise
+            return first, last, n - 1, f"no stroke: {exc}"
+        first, last = first or stroke, stroke
+        if not stroke.valid:
+            return first, last, n, f"invalid stroke ({stroke.invalid_reason})"
+        why = stop(stroke)
+        if why is not None:
+            return first, last, n, why
+    assert first is not None and last is not None  # max_strokes >= 1
+    return first, last, max_strokes, "strokes spent"
+
+
+def _combined(first: Outcome, last: Outcome, success: bool) -> Outcome:
+    """``last`` with ``first``'s ``pose_before`` and the call's ``success``."""
+    out = copy.copy(last)
+    out.pose_before = first.pose_before
+    out.success = bool(success)
+    return out
+
+
 def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], strides: int,
             direction: float | None = None) -> Strokes:
     """Push the object in ``sim`` to ``target_xy`` (world, metres) with up to ``strides + EXTRA_STROKES`` strokes
@@ -68,7 +106,8 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
     it more than ``MAX_TURN`` in all, did not move it ``MIN_PUSH_PROGRESS`` its way (a stroke that fails once here
     fails again: the cloud is the same), or carried it past the target; after an invalid stroke; and within
     ``STOP_WITHIN`` of the target. An error in a later stroke (no contact the arm can reach) ends the call with
-    the strokes made; in the first, it is raised.
+    the strokes made; in the first, it is raised. ``Strokes.outcome.success``: the object ended within
+    ``STOP_WITHIN`` of the target in its resting state, validly.
 
     Raises:
         InputError: a target that is not two finite numbers, ``strides`` not a whole number from 1 to 100, or a
@@ -81,54 +120,32 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
     obj = sim.obj
     state, x0, y0, yaw0 = obj.planar_pose(sim.object_pose())
     heading0 = math.atan2(target[1] - y0, target[0] - x0)
-    first, out, stopped, n = None, None, "strokes spent", 0
-    for n in range(1, strides + EXTRA_STROKES + 1):
+    asked: list[float] = []  # each stroke's heading
+
+    def ask() -> dict[str, float]:
         rest = target - sim.object_pose()[:2, 3]
-        heading = float(direction) if n == 1 and direction is not None else math.atan2(rest[1], rest[0])
-        try:
-            stroke = skill.execute(sim, {"direction": heading})
-        except AffordplanError as exc:  # e.g. no contact the arm can reach: the strokes made so far stand
-            if out is None:
-                raise
-            n -= 1
-            stopped = f"no stroke: {exc}"
-            break
-        out, first = stroke, first or stroke
+        asked.append(float(direction) if not asked and direction is not None else math.atan2(rest[1], rest[0]))
+        return {"direction": asked[-1]}
+
+    def stop(out: Outcome) -> str | None:
         s1, x1, y1, yaw1 = obj.planar_pose(out.pose_after)
-        if not out.valid:
-            stopped = f"invalid stroke ({out.invalid_reason})"
-            break
         if s1 != state:
-            stopped = "left its resting state"
-            break
+            return "left its resting state"
         if abs(float(wrap_angle(yaw1 - yaw0))) > MAX_TURN:
-            stopped = "turned"
-            break
-        if not made_progress(obj, "push", {"direction": heading}, out.pose_before, out.pose_after):
-            stopped = "did not move"
-            break
+            return "turned"
+        if not made_progress(obj, "push", {"direction": asked[-1]}, out.pose_before, out.pose_after):
+            return "did not move"
         if (target[0] - x1) * math.cos(heading0) + (target[1] - y1) * math.sin(heading0) < -STOP_WITHIN:
-            stopped = "passed the target"
-            break
-        if math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN:
-            stopped = "at the target"
-            break
-    assert out is not None and first is not None  # the loop makes at least one stroke (s1, x1, y1: its last)
-    combined = copy.copy(out)
-    combined.pose_before = first.pose_before
-    combined.success = bool(out.valid and s1 == state and math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN)
-    return Strokes(combined, n, stopped)
+            return "passed the target"
+        return "at the target" if math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN else None
+
+    first, last, n, stopped = _make_strokes(skill, sim, strides + EXTRA_STROKES, ask, stop)
+    s1, x1, y1, _ = obj.planar_pose(last.pose_after)
+    ok = last.valid and s1 == state and math.hypot(target[0] - x1, target[1] - y1) <= STOP_WITHIN
+    return Strokes(_combined(first, last, ok), n, stopped)
 
 
-def _combined(first: Outcome, last: Outcome, success: bool) -> Outcome:
-    """``last`` with ``first``'s ``pose_before`` and the call's ``success``."""
-    out = copy.copy(last)
-    out.pose_before = first.pose_before
-    out.success = bool(success)
-    return out
-
-
-def _turn(T_before, T_after) -> float:
+def _turn(T_before: np.ndarray, T_after: np.ndarray) -> float:
     """The signed turn about world +z from ``T_before`` to ``T_after`` (radians, within one half turn)."""
     return math.radians(rewards.signed_turn_deg(rewards.motion(T_before, T_after)))
 
@@ -158,36 +175,23 @@ def spin_by(skill: Skill, sim: Simulator, angle: float, max_strokes: int = 4) ->
     obj = sim.obj
     T0 = sim.object_pose()
     state = obj.classify(T0)
-    turned = 0.0  # summed stroke by stroke: no wrap at half a turn
-    first, out, stopped, n = None, None, "strokes spent", 0
-    for n in range(1, max_strokes + 1):
-        rest = angle - turned
-        ask = math.copysign(min(max(abs(rest), SPIN_MIN), SPIN_MAX), rest)
-        try:
-            stroke = skill.execute(sim, {"angle": ask})
-        except AffordplanError as exc:
-            if out is None:
-                raise
-            n -= 1
-            stopped = f"no stroke: {exc}"
-            break
-        out, first = stroke, first or stroke
-        turned += _turn(out.pose_before, out.pose_after)
-        if not out.valid:
-            stopped = f"invalid stroke ({out.invalid_reason})"
-            break
+    turned = [0.0]  # summed stroke by stroke: no wrap at half a turn
+
+    def ask() -> dict[str, float]:
+        rest = angle - turned[0]
+        return {"angle": math.copysign(min(max(abs(rest), SPIN_MIN), SPIN_MAX), rest)}
+
+    def stop(out: Outcome) -> str | None:
+        turned[0] += _turn(out.pose_before, out.pose_after)
         if obj.classify(out.pose_after) != state:
-            stopped = "left its resting state"
-            break
-        if abs(angle - turned) <= SPIN_TOLERANCE:
-            stopped = "at the angle"
-            break
-    assert out is not None and first is not None
-    m = rewards.motion(T0, out.pose_after)
-    upright = m.wz >= math.cos(math.radians(rewards.AXIS_TOLERANCE_DEG)) - 1e-9
-    on_angle = abs(float(wrap_angle(_turn(T0, out.pose_after) - angle))) <= SPIN_TOLERANCE + 1e-9
-    ok = out.valid and obj.classify(out.pose_after) == state and upright and on_angle
-    return Strokes(_combined(first, out, ok), n, stopped)
+            return "left its resting state"
+        return "at the angle" if abs(angle - turned[0]) <= SPIN_TOLERANCE else None
+
+    first, last, n, stopped = _make_strokes(skill, sim, max_strokes, ask, stop)
+    upright = rewards.motion(T0, last.pose_after).wz >= math.cos(math.radians(rewards.AXIS_TOLERANCE_DEG)) - 1e-9
+    on_angle = abs(float(wrap_angle(_turn(T0, last.pose_after) - angle))) <= SPIN_TOLERANCE + 1e-9
+    ok = last.valid and obj.classify(last.pose_after) == state and upright and on_angle
+    return Strokes(_combined(first, last, ok), n, stopped)
 
 
 def roll_to(skill: Skill, sim: Simulator, target: int, max_strokes: int = 3) -> Strokes:
@@ -212,26 +216,12 @@ def roll_to(skill: Skill, sim: Simulator, target: int, max_strokes: int = 3) -> 
     if target not in roll_targets(obj, state):
         raise InputError(f"state {target} is not one roll away from state {state} of {obj.name}; "
                          f"one roll away: {roll_targets(obj, state)}")
-    first, out, stopped, n = None, None, "strokes spent", 0
-    for n in range(1, max_strokes + 1):
-        try:
-            stroke = skill.execute(sim, {"target": target})
-        except AffordplanError as exc:
-            if out is None:
-                raise
-            n -= 1
-            stopped = f"no stroke: {exc}"
-            break
-        out, first = stroke, first or stroke
+
+    def stop(out: Outcome) -> str | None:
         now = obj.classify(out.pose_after)
-        if not out.valid:
-            stopped = f"invalid stroke ({out.invalid_reason})"
-            break
         if now == target:
-            stopped = "in the target state"
-            break
-        if now != state:
-            stopped = f"rolled into state {now}"
-            break
-    assert out is not None and first is not None
-    return Strokes(_combined(first, out, out.valid and obj.classify(out.pose_after) == target), n, stopped)
+            return "in the target state"
+        return None if now == state else f"rolled into state {now}"
+
+    first, last, n, stopped = _make_strokes(skill, sim, max_strokes, lambda: {"target": target}, stop)
+    return Strokes(_combined(first, last, last.valid and obj.classify(last.pose_after) == target), n, stopped)
