@@ -11,11 +11,11 @@ stroke it observes the object, aims the stroke at the run's end from where the o
 the object is within ``STOP_WITHIN`` of it, has passed it, has left its resting state or turned, has not moved,
 or the strokes are spent (the run's strides, plus :data:`EXTRA_STROKES`).
 
-**spin_by.** One spin stroke turns an object by an asked angle within ``SPIN_ANGLE_TOLERANCE_DEG`` (10 deg) less
-than half the time on unseen household objects: the policies turn it about 26 deg when asked 15. :func:`spin_by`
+**spin_by.** One spin stroke turns an object by an asked angle within ``SPIN_ANGLE_TOLERANCE_DEG`` (10 deg) about a
+third of the time on unseen household objects: the policies turn it about 26 deg when asked 15. :func:`spin_by`
 asks the rest: after each stroke it measures the object's turn so far and asks what remains (clamped into the
-skill's [``SPIN_MIN``, ``SPIN_MAX``]), until the turn is within the tolerance, the object left its resting state,
-or the strokes are spent. It also takes angles past ``SPIN_MAX`` (up to half a turn).
+skill's [``SPIN_MIN``, ``SPIN_MAX``]), until the criterion is met, the object left its resting state or turned
+about a tilted axis, or the strokes are spent. It also takes angles past ``SPIN_MAX`` (up to half a turn).
 
 **roll_to.** A roll that leaves the object where it was (it slid, or tipped back) is tried again from the new
 cloud, up to the strokes given; a roll into another state than the asked one ends the call.
@@ -145,21 +145,27 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
     return Strokes(_combined(first, last, ok), n, stopped)
 
 
-def _turn(T_before: np.ndarray, T_after: np.ndarray) -> float:
-    """The signed turn about world +z from ``T_before`` to ``T_after`` (radians, within one half turn)."""
-    return math.radians(rewards.signed_turn_deg(rewards.motion(T_before, T_after)))
+def _spun(T0: np.ndarray, T1: np.ndarray, angle: float) -> bool:
+    """The seed's spin-by-angle criterion from ``T0`` to ``T1`` (world poses) for any ``angle`` (radians): the turn
+    about world +z within ``SPIN_TOLERANCE`` of it, modulo a full turn, about an axis within the criterion's tilt.
+    For ``|angle| <= SPIN_MAX`` exactly :func:`primitives.rewards.success` (``"spin"``)."""
+    m = rewards.motion(T0, T1)
+    upright = m.wz >= math.cos(math.radians(rewards.AXIS_TOLERANCE_DEG)) - 1e-9
+    off = float(wrap_angle(math.radians(rewards.signed_turn_deg(m)) - angle))
+    return upright and abs(off) <= SPIN_TOLERANCE + 1e-9
 
 
 def spin_by(skill: Skill, sim: Simulator, angle: float, max_strokes: int = 4) -> Strokes:
     """Turn the object in ``sim`` by ``angle`` (radians about world +z, counter-clockwise positive) in place, with up
     to ``max_strokes`` strokes of the spin ``skill``, each asking the turn that remains (module docstring).
 
-    ``Strokes.outcome.success``: every stroke valid, the object in its starting resting state, its axis within
-    the spin criterion's tilt, and its turn within ``SPIN_TOLERANCE`` of ``angle`` (the seed's spin-by-angle
-    criterion; for ``|angle| <= SPIN_MAX`` exactly :func:`primitives.rewards.success`). The call ends within
-    ``SPIN_TOLERANCE`` of the angle, after an invalid stroke or one that left the resting state, and when the strokes
-    are spent. An error in a later stroke (no contact the arm can reach) ends the call with the strokes made; in
-    the first, it is raised.
+    The turn so far is the object's yaw in its resting state, followed stroke by stroke (so past half a turn).
+    ``Strokes.outcome.success``: every stroke valid, the object in its starting resting state, and the seed's
+    spin-by-angle criterion met from start to end (:func:`_spun`). The call ends when it is met, after an invalid
+    stroke or one that left the resting state, when the object has turned about an axis tilted past the
+    criterion's (a can on its side rolled about its length: no spin about the vertical undoes that), and when the
+    strokes are spent. An error in a later stroke (no contact the arm can reach) ends the call with the strokes
+    made; in the first, it is raised.
 
     Raises:
         InputError: ``angle`` not finite or not with ``SPIN_MIN <= |angle| <= pi``, ``max_strokes`` not a whole
@@ -174,23 +180,27 @@ def spin_by(skill: Skill, sim: Simulator, angle: float, max_strokes: int = 4) ->
     max_strokes = as_whole("max_strokes", max_strokes, 1, MAX_STROKES)
     obj = sim.obj
     T0 = sim.object_pose()
-    state = obj.classify(T0)
-    turned = [0.0]  # summed stroke by stroke: no wrap at half a turn
+    state, _, _, yaw0 = obj.planar_pose(T0)
+    yaw = [yaw0, 0.0]  # the last stroke's yaw, and the turn since the start summed stroke by stroke (no wrap)
 
     def ask() -> dict[str, float]:
-        rest = angle - turned[0]
+        rest = angle - yaw[1]
         return {"angle": math.copysign(min(max(abs(rest), SPIN_MIN), SPIN_MAX), rest)}
 
     def stop(out: Outcome) -> str | None:
-        turned[0] += _turn(out.pose_before, out.pose_after)
-        if obj.classify(out.pose_after) != state:
+        now, _, _, yaw1 = obj.planar_pose(out.pose_after)
+        if now != state:
             return "left its resting state"
-        return "at the angle" if abs(angle - turned[0]) <= SPIN_TOLERANCE else None
+        yaw[1] += float(wrap_angle(yaw1 - yaw[0]))
+        yaw[0] = yaw1
+        if _spun(T0, out.pose_after, angle):
+            return "at the angle"
+        if rewards.motion(T0, out.pose_after).wz < math.cos(math.radians(rewards.AXIS_TOLERANCE_DEG)):
+            return "turned about a tilted axis"
+        return None
 
     first, last, n, stopped = _make_strokes(skill, sim, max_strokes, ask, stop)
-    upright = rewards.motion(T0, last.pose_after).wz >= math.cos(math.radians(rewards.AXIS_TOLERANCE_DEG)) - 1e-9
-    on_angle = abs(float(wrap_angle(_turn(T0, last.pose_after) - angle))) <= SPIN_TOLERANCE + 1e-9
-    ok = last.valid and obj.classify(last.pose_after) == state and upright and on_angle
+    ok = last.valid and obj.classify(last.pose_after) == state and _spun(T0, last.pose_after, angle)
     return Strokes(_combined(first, last, ok), n, stopped)
 
 

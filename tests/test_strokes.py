@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 from planner_fakes import IdealSkill
+from scipy.spatial.transform import Rotation
 
 import affordplan as ap
 from affordplan.errors import InputError
@@ -163,6 +164,25 @@ def test_a_spin_that_tips_the_object_over_ends_the_call_unsuccessfully(sim, cube
 
     made = spin_by(Tipping("spin"), sim, math.radians(90.0), max_strokes=4)
     assert made.strokes == 1 and made.stopped == "left its resting state" and not made.outcome.success
+
+
+def test_a_spin_that_rolls_the_object_about_a_level_axis_ends_the_call(sim, cube):
+    """A can on its side rolled about its length stays in its resting state but is not spun: the call stops there."""
+
+    class Rolling(IdealSkill):
+        def execute(self, sim, params):
+            T0 = sim.object_pose()
+            self.calls.append((0, dict(params)))
+            T1 = T0.copy()
+            T1[:3, :3] = Rotation.from_rotvec([math.radians(40.0), 0.0, 0.0]).as_matrix() @ T0[:3, :3]
+            sim.set_object_pose(T1, settle=False)
+            return Outcome(T0, T1, 0, True, True, 0.0, success=False)
+
+    skill = Rolling("spin")
+    made = spin_by(skill, sim, math.radians(40.0), max_strokes=4)
+    assert cube.classify(made.outcome.pose_after) == cube.classify(made.outcome.pose_before)  # still "in its state"
+    assert made.strokes == 1 == len(skill.calls) and made.stopped == "turned about a tilted axis"
+    assert not made.outcome.success
 
 
 def test_spin_by_refuses_bad_input(sim):
