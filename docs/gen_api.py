@@ -26,8 +26,8 @@ OUT = ROOT / "docs" / "api.md"
 MODULES: list[tuple[str, list[str]]] = [
     ("Public surface", ["affordplan", "affordplan.errors", "affordplan.goal", "affordplan.world",
                         "affordplan.objects.model", "affordplan.objects.resting", "affordplan.sim.simulator",
-                        "primitives", "primitives.skills", "primitives.rewards", "primitives.params",
-                        "planner.api", "planner.plan", "planner.execute"]),
+                        "primitives", "primitives.skills", "primitives.strokes", "primitives.rewards",
+                        "primitives.params", "planner.api", "planner.plan", "planner.execute"]),
     ("Command line, scenes, pictures and video", ["affordplan.app.cli", "affordplan.app.scene_file",
                                                   "affordplan.app.demo", "affordplan.app.video",
                                                   "affordplan.app.render", "affordplan.app.viewer", "planner.plot"]),

@@ -1,6 +1,7 @@
 """Learned primitives: the seed's objectives, the one-step environment, the hybrid actor-critic,
 training (``python -m primitives.train``), evaluation (``python -m primitives.evaluate``) and the
-trained skills (``load_skill``, ``load_skills``).
+trained skills (``load_skill``, ``load_skills``), and calls of them that re-observe between strokes
+(:mod:`primitives.strokes`: ``push_to``, ``spin_by``, ``roll_to``).
 
 Skill names (:data:`SKILLS`, typed :data:`SkillName`) and their parameters as typed values
 (:class:`PushParams`, :class:`SpinParams`, :class:`RollParams`; see :mod:`primitives.params`).

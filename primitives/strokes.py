@@ -215,6 +215,11 @@ def roll_to(skill: Skill, sim: Simulator, target: int, max_strokes: int = 3) -> 
     in any other state, after an invalid stroke, and when the strokes are spent. An error in a later stroke ends
     the call with the strokes made; in the first, it is raised.
 
+    ``max_strokes``: 3 by default; on ``housekeep:validation`` (240 starts asked a state one roll away where there is
+    one, cameras) success within 1 / 2 / 3 / 4 / 6 strokes was 0.317 / 0.367 / 0.388 / 0.408 / 0.417
+    (``python -m primitives.evaluate roll --params random --frames shipped --strokes 6 --objects housekeep:validation
+    --trials 20``): past three, a stroke more buys about 0.02.
+
     Raises:
         InputError: ``target`` not a state one roll away, ``max_strokes`` not a whole number from 1 to
             ``MAX_STROKES``, or a skill that is not the roll.
