@@ -8,7 +8,14 @@ messages reach the user as plain lines on stderr, while the program's results (t
 
 from __future__ import annotations
 
+import functools
 import logging
+import sys
+from collections.abc import Callable
+
+from affordplan.errors import AffordplanError
+
+Main = Callable[[list[str] | None], int]  # a command line's ``main(argv) -> exit status``
 
 # The loggers a command line turns up: the three packages, and ``__main__``, the name a module run with
 # ``python -m package.module`` logs under.
@@ -36,3 +43,24 @@ def cli_logging(verbose: bool = False) -> None:
     level = logging.DEBUG if verbose else logging.INFO
     for name in CLI_LOGGERS:
         logging.getLogger(name).setLevel(level)
+
+
+def one_line_errors(prog: str, *errors: type[BaseException]) -> Callable[[Main], Main]:
+    """Decorate a command line's ``main(argv) -> int``: an :class:`~affordplan.errors.AffordplanError`, or one of
+    ``errors``, raised in it is printed as one line, ``{prog}: error: {message}``, on stderr, and ``main`` returns 2,
+    argparse's status for a refused command line. Anything else propagates with its traceback (a bug is not bad
+    input)."""
+    caught = (AffordplanError, *errors)
+
+    def decorate(main: Main) -> Main:
+        @functools.wraps(main)
+        def run(argv: list[str] | None = None) -> int:
+            try:
+                return main(argv)
+            except caught as exc:
+                print(f"{prog}: error: {exc}", file=sys.stderr)
+                return 2
+
+        return run
+
+    return decorate

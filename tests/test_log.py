@@ -1,12 +1,15 @@
-"""affordplan.log.cli_logging: a command line shows the library's messages as plain lines on stderr, and leaves
-logging that someone else configured alone."""
+"""affordplan.log: a command line shows the library's messages as plain lines on stderr and leaves logging that
+someone else configured alone (cli_logging); its bad input ends it with one line and status 2 (one_line_errors)."""
 
 from __future__ import annotations
 
 import logging
 from contextlib import contextmanager
 
-from affordplan.log import CLI_LOGGERS, cli_logging
+import pytest
+
+from affordplan.errors import InputError
+from affordplan.log import CLI_LOGGERS, cli_logging, one_line_errors
 
 
 @contextmanager
@@ -77,3 +80,21 @@ def test_logging_configured_by_the_caller_is_left_alone():
         assert root.handlers == [handler]
         assert {name: logging.getLogger(name).level for name in CLI_LOGGERS} == before
 
+
+
+def test_a_command_lines_bad_input_is_one_line_and_status_2_and_a_bug_is_a_traceback(capsys):
+    @one_line_errors("prog", OSError)
+    def main(argv=None):
+        if argv == ["bad"]:
+            raise InputError("--x must be positive, got -1")
+        if argv == ["missing"]:
+            raise FileNotFoundError("no file runs/x.npz")
+        if argv == ["bug"]:
+            raise KeyError("a bug")
+        return 0
+
+    assert main([]) == 0 and main.__name__ == "main"
+    assert main(["bad"]) == 2 and capsys.readouterr().err == "prog: error: --x must be positive, got -1\n"
+    assert main(["missing"]) == 2 and capsys.readouterr().err == "prog: error: no file runs/x.npz\n"
+    with pytest.raises(KeyError):
+        main(["bug"])

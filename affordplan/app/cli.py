@@ -13,6 +13,7 @@ import math
 import sys
 import textwrap
 
+from affordplan.log import one_line_errors
 from affordplan.robot import SKILLS
 
 VIDEO_QUALITIES = ("standard", "full", "fast")  # affordplan.app.video.QUALITIES, without importing the renderer
@@ -567,15 +568,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+@one_line_errors("affordplan")
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    from affordplan.errors import AffordplanError
-
-    try:
-        return args.func(args)
-    except AffordplanError as exc:
-        print(f"affordplan: error: {exc}", file=sys.stderr)
-        return 2
+    return args.func(args)
 
 
 if __name__ == "__main__":

@@ -38,15 +38,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
-from affordplan.log import cli_logging
+from affordplan.errors import InputError
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.simulator import Simulator
 from primitives.training.env import PrimitiveEnv
 from primitives.training.evaluate import greedy_action, held_out_config, load_policy
@@ -219,6 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("primitives.research.ceiling")  # missing or broken weights, ...
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -226,12 +226,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.starts < 1:
         parser.error(f"--starts must be a positive integer, got {args.starts}")
     torch.set_num_threads(1)
-    try:
-        result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json,
-                              aims=tuple(math.radians(a) for a in args.aim_deg))
-    except AffordplanError as exc:  # missing or broken weights, ...
-        print(f"primitives.research.ceiling: error: {exc}", file=sys.stderr)
-        return 2
+    result = push_ceiling(args.starts, args.params, args.seed, args.weights, progress=not args.json,
+                          aims=tuple(math.radians(a) for a in args.aim_deg))
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     return 0
 

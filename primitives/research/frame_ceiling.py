@@ -28,15 +28,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from dataclasses import dataclass
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError
-from affordplan.log import cli_logging
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.sensor import SENSORS
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
@@ -211,6 +209,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("primitives.research.frame_ceiling")  # missing or broken weights, an unreadable frames file, ...
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -218,12 +217,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.starts < 1:
         parser.error(f"--starts must be a positive integer, got {args.starts}")
     torch.set_num_threads(1)
-    try:
-        result = frame_ceiling(args.skill, args.starts, args.params, args.seed, args.weights, args.model,
-                               args.frames, progress=not args.json, objects=args.objects, sensor=args.sensor)
-    except AffordplanError as exc:  # missing or broken weights, an unreadable frames file, ...
-        print(f"primitives.research.frame_ceiling: error: {exc}", file=sys.stderr)
-        return 2
+    result = frame_ceiling(args.skill, args.starts, args.params, args.seed, args.weights, args.model,
+                           args.frames, progress=not args.json, objects=args.objects, sensor=args.sensor)
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     if args.plot:
         result.plot(args.plot)

@@ -33,15 +33,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from dataclasses import dataclass
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
-from affordplan.log import cli_logging
+from affordplan.errors import InputError
+from affordplan.log import cli_logging, one_line_errors
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.networks import HybridActorCritic
 from primitives.research.frame_ceiling import add_held_out_arguments
@@ -218,18 +217,15 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("primitives.research.sensitivity")  # bad sizes, broken weights, an unreadable frames file, ...
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     cli_logging()
     torch.set_num_threads(1)
-    try:
-        result = sensitivity(args.skill, args.starts, args.params, args.options, args.seed,
-                             np.radians(args.motion_deg), 1e-3 * args.contact_mm, args.weights, args.model,
-                             args.frames, progress=not args.json)
-    except AffordplanError as exc:  # bad sizes, missing or broken weights, an unreadable frames file, ...
-        print(f"primitives.research.sensitivity: error: {exc}", file=sys.stderr)
-        return 2
+    result = sensitivity(args.skill, args.starts, args.params, args.options, args.seed,
+                         np.radians(args.motion_deg), 1e-3 * args.contact_mm, args.weights, args.model,
+                         args.frames, progress=not args.json)
     print(json.dumps(result.as_dict(), indent=2) if args.json else result.report())
     if args.plot:
         result.plot(args.plot)

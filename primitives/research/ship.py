@@ -40,13 +40,12 @@ import argparse
 import hashlib
 import os
 import shutil
-import sys
 import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from affordplan.errors import AffordplanError, InputError, WeightsError
-from affordplan.log import cli_logging
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.sensor import SENSORS
 from primitives import weights_file
 from primitives.frames import FrameSearch
@@ -285,6 +284,7 @@ def ship(plan: ShipPlan, release: str) -> None:
             relabel(path, release, plan.digests)
 
 
+@one_line_errors("python -m primitives.research.ship")
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m primitives.research.ship", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -300,11 +300,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--dry-run", action="store_true", help="check and print what would move; change nothing")
     args = parser.parse_args(argv)
     cli_logging()
-    try:
-        plan = plan_ship(args.skill, args.source, args.keep, args.weights_dir, sensor=args.sensor)
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    plan = plan_ship(args.skill, args.source, args.keep, args.weights_dir, sensor=args.sensor)
     print(plan.describe())
     if args.dry_run:
         print("dry run: nothing changed")

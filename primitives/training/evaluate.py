@@ -20,15 +20,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
-from affordplan.log import cli_logging
+from affordplan.errors import InputError
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.objects import housekeep
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
@@ -385,6 +384,7 @@ def _objects(args: argparse.Namespace) -> str | tuple[str, ...]:
     return one if len(args.objects) == 1 and (":" in one or one in ("random", "seed7")) else tuple(args.objects)
 
 
+@one_line_errors("primitives.training.evaluate")  # missing or broken weights, an unreadable mesh, ...
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -396,18 +396,13 @@ def main(argv: list[str] | None = None) -> int:
     if not 1 <= args.strokes <= 20:
         parser.error(f"--strokes must be from 1 to 20, got {args.strokes}")
     torch.set_num_threads(1)
-    try:
-        if args.strokes != 1:
-            return _main_strokes(args, parser)
-        model = load_policy(args.weights, args.primitive)
-        objects = _objects(args)
-        search = _frame_search(args, parser)
-        result = evaluate(model, args.primitive, objects, args.trials, args.seed, progress=not args.json,
-                          p_params=1.0 if args.params == "random" else 0.0, frame_search=search,
-                          success_weights=args.success_weights, sensor=args.sensor)
-    except AffordplanError as exc:  # missing or broken weights, an unreadable mesh, ...
-        print(f"primitives.training.evaluate: error: {exc}", file=sys.stderr)
-        return 2
+    if args.strokes != 1:
+        return _main_strokes(args, parser)
+    model = load_policy(args.weights, args.primitive)
+    search = _frame_search(args, parser)
+    result = evaluate(model, args.primitive, _objects(args), args.trials, args.seed, progress=not args.json,
+                      p_params=1.0 if args.params == "random" else 0.0, frame_search=search,
+                      success_weights=args.success_weights, sensor=args.sensor)
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
     else:

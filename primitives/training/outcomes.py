@@ -104,9 +104,9 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
+from affordplan.errors import InputError
 from affordplan.geometry import wrap_angle
-from affordplan.log import cli_logging
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.sim.simulator import Simulator
 from primitives import params as skill_params
@@ -309,6 +309,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("primitives.training.outcomes")
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -317,7 +318,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             for path in args.files:
                 print(json.dumps(annotate(path)))
-        except (AffordplanError, OSError, ValueError) as exc:
+        except (OSError, ValueError) as exc:  # an unreadable or foreign file, besides bad input
             print(f"primitives.training.outcomes: error: {exc}", file=sys.stderr)
             return 2
         return 0
@@ -327,22 +328,18 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("collect needs --out")
     torch.set_num_threads(1)
     command = "python -m primitives.training.outcomes " + shlex.join(sys.argv[1:] if argv is None else argv)
-    try:
-        model = None
-        if args.command == "check":
-            from primitives.outcome_model import OutcomeModel
+    model = None
+    if args.command == "check":
+        from primitives.outcome_model import OutcomeModel
 
-            model = OutcomeModel.load(args.skill, args.model)
-        skills = load_skills()
-        t0 = time.perf_counter()
-        data = collect(args.skill, skills, args.rollouts, args.objects, args.seed, args.n_objects,
-                       progress=not getattr(args, "json", False))
-        wall = time.perf_counter() - t0
-        if args.out is not None:
-            save(args.out, data, args.skill, args.objects, command)
-    except AffordplanError as exc:
-        print(f"primitives.training.outcomes: error: {exc}", file=sys.stderr)
-        return 2
+        model = OutcomeModel.load(args.skill, args.model)
+    skills = load_skills()
+    t0 = time.perf_counter()
+    data = collect(args.skill, skills, args.rollouts, args.objects, args.seed, args.n_objects,
+                   progress=not getattr(args, "json", False))
+    wall = time.perf_counter() - t0
+    if args.out is not None:
+        save(args.out, data, args.skill, args.objects, command)
     summary = dict(rows=int(len(data["p"])), skipped=int(data["skipped"]), objects=int(len(data["objects"])),
                    wall_s=round(wall, 1), success=float(data["success"].mean()),
                    made_progress=float(data["made_progress"].mean()), mean_progress=float(data["progress"].mean()),

@@ -31,7 +31,6 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -41,8 +40,8 @@ import torch
 from torch import nn
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
-from affordplan.log import cli_logging
+from affordplan.errors import InputError
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.sensor import SENSORS
 from primitives.frames import FrameSearch, load_frame_search
 from primitives.option_ranker import (
@@ -302,25 +301,22 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("python -m primitives.training.ranker")
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     cli_logging()
     torch.set_num_threads(1)
-    try:
-        if args.command == "collect":
-            out = collect(args.skill, args.out, args.starts, args.params, args.objects, args.sensor, args.seed,
-                          args.chunk)
-            print(f"collected {args.starts} starts of {args.skill} into {out}")
-            return 0
-        if args.command == "attach":
-            print(f"wrote {attach(args.skill, args.ranker, args.out, args.frames, args.sensor)}")
-            return 0
-        info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, args.members,
-                   refit=args.refit, progress=not args.json)
-    except AffordplanError as exc:
-        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
-        return 2
+    if args.command == "collect":
+        out = collect(args.skill, args.out, args.starts, args.params, args.objects, args.sensor, args.seed,
+                      args.chunk)
+        print(f"collected {args.starts} starts of {args.skill} into {out}")
+        return 0
+    if args.command == "attach":
+        print(f"wrote {attach(args.skill, args.ranker, args.out, args.frames, args.sensor)}")
+        return 0
+    info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, args.members,
+               refit=args.refit, progress=not args.json)
     if args.json:
         print(json.dumps(info, indent=2))
     else:

@@ -20,15 +20,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from affordplan.errors import AffordplanError, InputError
-from affordplan.log import cli_logging
+from affordplan.errors import InputError
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.sensor import SENSORS
 from primitives import weights_file
 from primitives.frames import load_frame_search
@@ -109,6 +108,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("primitives.training.recalibrate")  # held-out objects, a missing or broken model, ...
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -116,12 +116,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.rollouts < 1:
         parser.error(f"--rollouts must be a positive integer, got {args.rollouts}")
     torch.set_num_threads(1)
-    try:
-        check_objects(args.objects, fitting=True)
-        return run(args)
-    except AffordplanError as exc:  # held-out objects, a missing or broken model, ...
-        print(f"primitives.training.recalibrate: error: {exc}", file=sys.stderr)
-        return 2
+    check_objects(args.objects, fitting=True)
+    return run(args)
 
 
 def run(args: argparse.Namespace) -> int:

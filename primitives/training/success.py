@@ -42,7 +42,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 import time
 import zipfile
 import zlib
@@ -54,8 +53,8 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
-from affordplan.errors import AffordplanError, InputError
-from affordplan.log import cli_logging
+from affordplan.errors import InputError
+from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.sensor import SENSORS
 from primitives import weights_file
 from primitives.frames import FrameSearch, load_frame_search, rating_logit, reframe, reframe_obs
@@ -677,6 +676,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("primitives.training.success")  # missing or broken policy or success model, ...
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -707,11 +707,7 @@ def main(argv: list[str] | None = None) -> int:
     if getattr(args, "stand_ins", 0) and args.stand_in_rollouts < 1:
         parser.error(f"--stand-in-rollouts must be a positive integer, got {args.stand_in_rollouts}")
     torch.set_num_threads(1)
-    try:
-        return _run(args)
-    except AffordplanError as exc:  # missing or broken policy or success model, ...
-        print(f"primitives.training.success: error: {exc}", file=sys.stderr)
-        return 2
+    return _run(args)
 
 
 def _run(args: argparse.Namespace) -> int:

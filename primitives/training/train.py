@@ -54,7 +54,6 @@ import logging
 import os
 import resource
 import signal
-import sys
 import time
 from collections import deque
 from dataclasses import asdict, dataclass
@@ -67,7 +66,7 @@ from tqdm import tqdm
 
 from affordplan.checks import is_finite, require_probability, require_whole
 from affordplan.errors import InputError
-from affordplan.log import cli_logging
+from affordplan.log import cli_logging, one_line_errors
 from primitives import weights_file
 from primitives.networks import HybridActorCritic
 from primitives.training import checkpoint as ckpt
@@ -555,6 +554,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@one_line_errors("python -m primitives.train")  # a bad configuration or checkpoint: one line, not a traceback
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -578,11 +578,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(str(exc))
     signal.signal(signal.SIGTERM, _raise_interrupt)  # a polite kill stops like Ctrl-C: checkpoint, then exit
     signal.signal(signal.SIGINT, signal.default_int_handler)  # also when started in the background (SIG_IGN)
-    try:
-        summary = train(cfg, resume=args.resume)
-    except (InputError, ckpt.CheckpointError) as exc:  # one line, not a traceback
-        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
-        return 2
+    summary = train(cfg, resume=args.resume)
     print(json.dumps({k: v for k, v in summary.items() if k != "rss_samples"}, indent=2))
     if summary["interrupted"]:
         logger.warning("interrupted at step %s: checkpoint saved; continue with --resume --out %s",
