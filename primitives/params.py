@@ -65,7 +65,8 @@ def _spin_angle(value: object) -> float:
     angle = as_finite("spin angle (radians)", value)
     if not SPIN_MIN - 1e-9 <= abs(angle) <= SPIN_MAX + 1e-9:
         raise InputError(f"spin angle must be between {math.degrees(SPIN_MIN):.0f} and {math.degrees(SPIN_MAX):.0f} "
-                         f"degrees either way, got {math.degrees(angle):.1f} deg (chain spins for more)")
+                         f"degrees either way, got {math.degrees(angle):.1f} deg (primitives.strokes.spin_by turns "
+                         f"by up to 180 in one call of several strokes)")
     return angle
 
 
