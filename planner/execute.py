@@ -4,10 +4,11 @@
 the goal is reached, stop; if the pose is off the plan (more than ``XY_TOL`` / ``YAW_TOL`` from where
 the next step expects it, or in another resting state), replan from the observed pose; execute the
 next step's skill with its parameter (a push of several strides is one call that corrects its course between
-strokes, :func:`primitives.strokes.push_to`); remember failures (calls that did not move the object the way
-they asked: :func:`made_progress`), so that a (state, skill, parameter) that failed twice is avoided
-by the next plan. It stops on success, on ``max_primitives``, or when no plan
-can be found.
+strokes, :func:`primitives.strokes.push_to`; with ``spin_strokes`` > 1 a spin is one call of up to that many
+strokes that asks for the rest of its turn between them, :func:`primitives.strokes.spin_by`); remember failures
+(calls that did not move the object the way they asked: :func:`made_progress`), so that a (state, skill,
+parameter) that failed twice is avoided by the next plan. It stops on success, on ``max_primitives``, or when no
+plan can be found.
 
 :func:`execute_greedy` is the reactive baseline a user would otherwise reach for (HACMan-style):
 at every step, among pushes in 8 directions, spins of 30 deg either way and rolls to each state one
@@ -25,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from affordplan.checks import as_whole
 from affordplan.errors import AffordplanError, InputError
 from affordplan.geometry import wrap_period
 from affordplan.goal import Goal
@@ -34,13 +36,14 @@ from planner.predict import expected_pose
 from primitives import params as skill_params
 from primitives.params import made_progress
 from primitives.skills import Skill, skills_sensor
-from primitives.strokes import MAX_TURN, STOP_WITHIN, push_to
+from primitives.strokes import MAX_TURN, STOP_WITHIN, push_to, spin_by
 
 if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its plans
     from planner.plan import Planner
 
 XY_TOL = STOP_WITHIN  # metres off the plan before replanning: where a push's strokes stop short of their target
 YAW_TOL = MAX_TURN  # radians off the plan before replanning: the most a push's strokes may turn the object
+SPIN_STROKES = 1  # strokes one spin call of a plan may make (1: one stroke per spin step)
 
 
 @dataclass
@@ -189,13 +192,18 @@ def _terminal(out) -> str | None:
 
 
 def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0,
-                 skills: Mapping[str, Skill] | None = None, memory: Planner | None = None) -> Execution:
+                 skills: Mapping[str, Skill] | None = None, memory: Planner | None = None,
+                 spin_strokes: int = SPIN_STROKES) -> Execution:
     """Run ``plan`` closed-loop (see the module docstring).
+
+    ``spin_strokes``: the strokes one spin step may make, re-observing between them (:func:`primitives.strokes.spin_by`
+    for the step's angle); 1, one stroke.
 
     ``skills``: the skills that act (default: the ones the plan was rated with). ``memory``: the planner that replans
     and remembers failures (default: a fork of the plan's planner, :meth:`planner.plan.Planner.fork`), so the plan
     and its planner are left as they were; pass one planner to several executions to let them share what failed.
     """
+    spin_strokes = as_whole("spin_strokes", spin_strokes, 1, 20)
     planner, goal = memory if memory is not None else plan.planner.fork(), plan.goal
     skills = skills if skills is not None else planner.predictor.skills
     obj = planner.obj
@@ -233,6 +241,9 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         try:
             if step.skill == "push" and step.strides > 1:
                 made = push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides, step.params["direction"])
+                out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
+            elif step.skill == "spin" and spin_strokes > 1:
+                made = spin_by(skill, sim, step.params["angle"], spin_strokes)
                 out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
             else:
                 out = skill.execute(sim, step.params)

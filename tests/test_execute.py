@@ -249,3 +249,31 @@ def test_a_push_of_several_strides_is_one_primitive_of_several_strokes():
     assert runs[4].n_primitives < runs[1].n_primitives and runs[4].strokes <= runs[1].strokes
     assert any(e.strokes > 1 for e in runs[4].log) and all(e.strokes == 1 for e in runs[1].log)
     assert "strokes" in str(runs[4])
+
+
+class HalfSpin(IdealSkill):
+    """A spin that turns the object half the asked angle (a real policy's turn follows its ask loosely)."""
+
+    def execute(self, sim, params):
+        return super().execute(sim, {"angle": 0.5 * params["angle"]})
+
+
+def test_a_spin_step_of_several_strokes_asks_for_the_rest_of_its_turn_within_one_call():
+    cube = ap.load_object("cube")
+    T0 = cube.resting_states[0].pose((0.5, 0.0), 0.0)
+    goal = ap.Goal(xy=(0.5, 0.0), yaw=math.radians(40.0), yaw_tol=math.radians(15.0))
+    runs = {}
+    for k in (1, 4):
+        skills = {"push": IdealSkill("push"), "spin": HalfSpin("spin"), "roll": IdealSkill("roll")}
+        plan = Planner(cube, predictor=StubPredictor(skills), seed=0).plan(T0, goal)
+        assert [s.skill for s in plan.steps] == ["spin"]
+        sim = ap.Simulator(cube, seed=0)
+        sim.set_object_pose(T0, settle=False)
+        runs[k] = execute_plan(plan, sim=sim, max_primitives=10, spin_strokes=k)
+        assert runs[k].success, str(runs[k])
+    # one stroke a call: the half turn (20 deg) leaves the object off plan, and a replanned spin turns it 10 more
+    assert runs[1].n_primitives == 2 and runs[1].replans == 1
+    # calls of several strokes: the first call asks for the rest (20 deg) itself and stops within 10 deg of 40
+    assert runs[4].n_primitives == 1 and runs[4].log[0].strokes == 2 and runs[4].replans == 0
+    with pytest.raises(ap.errors.InputError, match="spin_strokes"):
+        execute_plan(plan, sim=ap.Simulator(cube, seed=0), spin_strokes=0)

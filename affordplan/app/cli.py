@@ -151,7 +151,8 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
     report = bench_plan(args.tasks, sim=args.sim, seed=args.seed, planners=tuple(args.planner),
                         max_primitives=args.max_primitives, progress=not args.json and not args.log,
                         only=args.task, log=log, weights_dir=args.weights_dir, draw=args.draw,
-                        objects=args.objects, max_strides=args.max_strides or MAX_STRIDES)
+                        objects=args.objects, max_strides=args.max_strides or MAX_STRIDES,
+                        spin_strokes=args.spin_strokes)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -531,6 +532,10 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--max-strides", type=_positive_int, default=None, metavar="K",
                     help="5 cm strides one push call may make, correcting its course between strokes; 1: one "
                          "stroke per push, as until 0.24 (default: the planner's, planner.plan.MAX_STRIDES)")
+    bp.add_argument("--spin-strokes", type=_positive_int, default=None, metavar="K",
+                    help="strokes one spin step may make, asking for the rest of its turn between them "
+                         "(primitives.strokes.spin_by); 1: one stroke per spin (default: "
+                         "planner.execute.SPIN_STROKES)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     bf = bench_sub.add_parser(

@@ -235,10 +235,10 @@ def plan_calibration(predicted: Sequence[float], reached: Sequence[bool], bins: 
 
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
              max_primitives: int, time_limit: float, log: Callable[[str], None] | None = None,
-             max_strides: int = MAX_STRIDES) -> TaskResult:
+             max_strides: int = MAX_STRIDES, spin_strokes: int | None = None) -> TaskResult:
     """Plan and execute ``task`` with one planner; ``log``, when given, receives the first plan and the
     execution's step log (:class:`planner.execute.Execution`) as text. ``max_strides``: as
-    :func:`planner.api.plan`."""
+    :func:`planner.api.plan`; ``spin_strokes``: as :meth:`planner.plan.Plan.execute`."""
     from planner.api import plan as make_plan
 
     p_goal = float(obj.resting_states[task.goal.resting_state].probability)
@@ -251,7 +251,7 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
             log(f"{planner_name}: no plan: {exc}")
         return TaskResult(planner_name, task.scene, False, time.perf_counter() - t0, 0, 0, f"no plan: {exc}",
                           p_goal, missed="no plan")
-    ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed)
+    ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed, spin_strokes=spin_strokes)
     if log is not None:
         log(f"{planner_name}: {p}\n{ex}")
     first = p.planning_time if planner_name == "affordplan" else ex.planning_time / max(1, ex.n_primitives)
@@ -292,7 +292,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
                only: Sequence[int] | None = None, log: Callable[[str], None] | None = None,
                weights_dir: str | os.PathLike | None = None, draw: int = 0, objects: str = "procedural",
-               max_strides: int = MAX_STRIDES) -> BenchReport:
+               max_strides: int = MAX_STRIDES, spin_strokes: int | None = None) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring).
 
     ``draw``: 0 runs the standard bench; ``k > 0`` runs the same tasks (objects, scenes, starts, goals) with the
@@ -307,8 +307,9 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     ``objects``: the tasks' objects, one of :data:`OBJECT_SETS` (:func:`task_object`).
 
     ``max_strides``: the 5 cm strides one push call of the affordplan planner may make (:func:`planner.api.plan`);
-    1 benches pushes of one stroke each, as until 0.24. Each task reports its calls (``primitives``) and its
-    fingertip strokes.
+    1 benches pushes of one stroke each, as until 0.24. ``spin_strokes``: the strokes one spin step of the affordplan
+    planner's plans may make (:meth:`planner.plan.Plan.execute`; default :data:`planner.execute.SPIN_STROKES`). Each
+    task reports its calls (``primitives``) and its fingertip strokes.
 
     ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
     run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
@@ -336,7 +337,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
             if log is not None:
                 log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")
             result = run_task(task, obj, name, sim, predictor, task_seed(seed, i, draw), max_primitives, time_limit,
-                              log, max_strides)
+                              log, max_strides, spin_strokes)
             result.task = i
             report.results.append(result)
         bar.update(1)
