@@ -139,7 +139,10 @@ def _spin_angle(T0, T1, angle: float) -> tuple[float, bool]:
     m = motion(T0, T1)
     err = abs(signed_turn_deg(m) - math.degrees(angle))
     loss = 1.0 - m.wz + err / SPIN_MIN_ROTATION_DEG + 2.5 * m.p_xy
-    ok = err <= SPIN_ANGLE_TOLERANCE_DEG + _EPS and m.wz >= math.cos(math.radians(AXIS_TOLERANCE_DEG)) - _EPS
+    # met modulo a full turn, so that any angle up to half a turn can be asked (primitives.strokes.spin_by); for the
+    # skill's own 15-45 deg this is the plain error (the two differ only past 135 deg off, far outside the tolerance)
+    off = abs((err + 180.0) % 360.0 - 180.0)
+    ok = off <= SPIN_ANGLE_TOLERANCE_DEG + _EPS and m.wz >= math.cos(math.radians(AXIS_TOLERANCE_DEG)) - _EPS
     return loss, bool(ok)
 
 

@@ -32,8 +32,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from affordplan.checks import as_finite, as_vector, as_whole
 from affordplan.errors import AffordplanError, InputError
 from affordplan.geometry import wrap_angle
@@ -47,7 +45,6 @@ if TYPE_CHECKING:
 EXTRA_STROKES = 1  # strokes a call may take beyond its strides (one stroke that fell short)
 STOP_WITHIN = 0.025  # metres from the target at which the strokes stop (the executor replans past it: XY_TOL)
 MAX_TURN = math.radians(12.0)  # turning the object more than this ends the call (the executor's YAW_TOL is it)
-SPIN_TOLERANCE = math.radians(rewards.SPIN_ANGLE_TOLERANCE_DEG)  # a spin call stops within this of its angle
 MAX_STROKES = 20  # the most strokes one call may be given
 
 
@@ -145,27 +142,18 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
     return Strokes(_combined(first, last, ok), n, stopped)
 
 
-def _spun(T0: np.ndarray, T1: np.ndarray, angle: float) -> bool:
-    """The seed's spin-by-angle criterion from ``T0`` to ``T1`` (world poses) for any ``angle`` (radians): the turn
-    about world +z within ``SPIN_TOLERANCE`` of it, modulo a full turn, about an axis within the criterion's tilt.
-    For ``|angle| <= SPIN_MAX`` exactly :func:`primitives.rewards.success` (``"spin"``)."""
-    m = rewards.motion(T0, T1)
-    upright = m.wz >= math.cos(math.radians(rewards.AXIS_TOLERANCE_DEG)) - 1e-9
-    off = float(wrap_angle(math.radians(rewards.signed_turn_deg(m)) - angle))
-    return upright and abs(off) <= SPIN_TOLERANCE + 1e-9
-
-
 def spin_by(skill: Skill, sim: Simulator, angle: float, max_strokes: int = 6) -> Strokes:
     """Turn the object in ``sim`` by ``angle`` (radians about world +z, counter-clockwise positive) in place, with up
     to ``max_strokes`` strokes of the spin ``skill``, each asking the turn that remains (module docstring).
 
     The turn so far is the object's yaw in its resting state, followed stroke by stroke (so past half a turn).
     ``Strokes.outcome.success``: every stroke valid, the object in its starting resting state, and the seed's
-    spin-by-angle criterion met from start to end (:func:`_spun`). The call ends when it is met, after an invalid
-    stroke or one that left the resting state, and when the strokes are spent. A stroke that turned the object about
-    a tilted axis (a can on its side rolled about its length) does not end it: later strokes often undo it (on
-    ``housekeep:validation`` ending there cost 0.804 -> 0.738 of calls of 6 strokes). An error in a later stroke (no
-    contact the arm can reach) ends the call with the strokes made; in the first, it is raised.
+    spin-by-angle criterion (:func:`primitives.rewards.success`, met modulo a full turn) from start to end. The call
+    ends when it is met, after an invalid stroke or one that left the resting state, and when the strokes are spent.
+    A stroke that turned the object about a tilted axis (a can on its side rolled about its length) does not end it:
+    later strokes often undo it (on ``housekeep:validation`` ending there cost 0.804 -> 0.738 of calls of 6 strokes).
+    An error in a later stroke (no contact the arm can reach) ends the call with the strokes made; in the first, it
+    is raised.
 
     ``max_strokes``: 6 by default, chosen on ``housekeep:validation`` (240 asked angles, camera clouds): success within
     1 / 2 / 4 / 6 strokes 0.400 / 0.554 / 0.742 / 0.804 (``python -m primitives.evaluate spin --params random
@@ -197,12 +185,13 @@ def spin_by(skill: Skill, sim: Simulator, angle: float, max_strokes: int = 6) ->
             return "left its resting state"
         yaw[1] += float(wrap_angle(yaw1 - yaw[0]))
         yaw[0] = yaw1
-        if _spun(T0, out.pose_after, angle):
+        if rewards.success("spin", T0, out.pose_after, {"angle": angle}):
             return "at the angle"
         return None
 
     first, last, n, stopped = _make_strokes(skill, sim, max_strokes, ask, stop)
-    ok = last.valid and obj.classify(last.pose_after) == state and _spun(T0, last.pose_after, angle)
+    ok = last.valid and obj.classify(last.pose_after) == state and rewards.success("spin", T0, last.pose_after,
+                                                                                    {"angle": angle})
     return Strokes(_combined(first, last, ok), n, stopped)
 
 

@@ -138,3 +138,12 @@ def test_bad_pose_raises():
         rewards.push_loss(np.full((4, 4), np.nan), T0)
     with pytest.raises(InputError):
         rewards.spin_success(np.eye(3), T0)
+
+
+@pytest.mark.parametrize("asked, turned, ok", [(30.0, 38.0, True), (30.0, 41.0, False), (-45.0, -36.0, True),
+                                               (175.0, -175.0, True), (-175.0, 178.0, True), (175.0, 160.0, False),
+                                               (175.0, -5.0, False)])
+def test_spin_by_an_angle_is_met_modulo_a_full_turn(asked, turned, ok):
+    """Within 10 deg of the asked turn; an asked half turn met by turning just past it (the signed turn wraps)."""
+    T1 = pose(rotvec_deg=(0.0, 0.0, turned))
+    assert rewards.success("spin", T0, T1, {"angle": math.radians(asked)}) is ok
