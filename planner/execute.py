@@ -36,7 +36,7 @@ from planner.predict import expected_pose
 from primitives import params as skill_params
 from primitives.params import made_progress
 from primitives.skills import Skill, skills_sensor
-from primitives.strokes import MAX_TURN, STOP_WITHIN, push_to, spin_by
+from primitives.strokes import MAX_STROKES, MAX_TURN, STOP_WITHIN, push_to, spin_by
 
 if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its plans
     from planner.plan import Planner
@@ -203,7 +203,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
     and remembers failures (default: a fork of the plan's planner, :meth:`planner.plan.Planner.fork`), so the plan
     and its planner are left as they were; pass one planner to several executions to let them share what failed.
     """
-    spin_strokes = as_whole("spin_strokes", spin_strokes, 1, 20)
+    spin_strokes = as_whole("spin_strokes", spin_strokes, 1, MAX_STROKES)
     planner, goal = memory if memory is not None else plan.planner.fork(), plan.goal
     skills = skills if skills is not None else planner.predictor.skills
     obj = planner.obj

@@ -33,6 +33,7 @@ from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
 from primitives.policy import greedy_action, load_policy  # noqa: F401  (re-exported: older imports)
 from primitives.skills import Skill, load_skill
+from primitives.strokes import MAX_STROKES, Strokes, roll_to, spin_by
 from primitives.training.env import PRIMITIVES, SEED_SEVEN, EnvConfig, PrimitiveEnv
 
 # The seed's Fig. 5 (success per object, push / roll / spin) and Fig. 3 (means over its random objects).
@@ -136,6 +137,16 @@ def object_list(objects: str | tuple[str, ...]) -> tuple[str, ...]:
     return (objects,) if isinstance(objects, str) else tuple(objects)
 
 
+def _trials(primitive: str, objects: str | tuple[str, ...], trials: int, p_params: float,
+            sensor: str) -> tuple[EnvConfig, list[str | None]]:
+    """The environment of an evaluation and each trial's object key (``None``: drawn from the procedural test
+    split), ``trials`` per named object."""
+    if objects == "random":
+        return held_out_config(primitive, p_params, sensor), [None] * trials
+    names = object_list(objects)
+    return named_objects_config(primitive, names, p_params, sensor), [n for n in names for _ in range(trials)]
+
+
 def seed_reference(name: str) -> tuple[float, float, float] | None:
     """The seed's Fig. 5 figures (push, roll, spin) for a seed object or its real counterpart."""
     real = {housekeep.PREFIX + v: k for k, v in SEED_SEVEN_REAL.items()}
@@ -160,13 +171,7 @@ def evaluate(model: HybridActorCritic, primitive: str, objects: str | tuple[str,
 
         rater = SuccessModel(model, load_success_net(primitive, success_weights, sensor))
         predict, decide = rater.predict, rater.rate_and_decide
-    if objects == "random":
-        cfg = held_out_config(primitive, p_params, sensor)
-        plan = [None] * trials
-    else:
-        names = object_list(objects)
-        cfg = named_objects_config(primitive, names, p_params, sensor)
-        plan = [n for n in names for _ in range(trials)]
+    cfg, plan = _trials(primitive, objects, trials, p_params, sensor)
     env = PrimitiveEnv(cfg, seed=seed)
     result = EvalResult(primitive, objects if isinstance(objects, str) else "paths", sensor=sensor,
                         params={0.0: "none", 1.0: "random"}.get(p_params, f"p={p_params:.2f}"))
@@ -201,13 +206,9 @@ def evaluate_strokes(skill: Skill, objects: str | tuple[str, ...] = "random", tr
     ratings for ``sensor``'s clouds). Judged by each call's criterion, the asked parameter's; a start with nothing to
     ask (a roll from a state with no state one roll away) is one stroke of the seed's objective, as :func:`evaluate`
     judges it."""
-    from primitives.strokes import Strokes, roll_to, spin_by
-
     if skill.name not in ("spin", "roll"):
         raise InputError(f"calls of several strokes are spin_by and roll_to; {skill.name} has none")
-    cfg = held_out_config(skill.name, 1.0, sensor) if objects == "random" else \
-        named_objects_config(skill.name, object_list(objects), 1.0, sensor)
-    plan = [None] * trials if objects == "random" else [n for n in object_list(objects) for _ in range(trials)]
+    cfg, plan = _trials(skill.name, objects, trials, 1.0, sensor)
     env = PrimitiveEnv(cfg, seed=seed)
     result = EvalResult(skill.name, objects if isinstance(objects, str) else "paths", sensor=sensor, params="random",
                         frames=f"calls of up to {max_strokes} strokes")
@@ -393,8 +394,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--trials must be a positive integer, got {args.trials}")
     if args.strokes != 1 and (args.params != "random" or args.primitive == "push" or args.plot or args.critic_map):
         parser.error("--strokes takes spin or roll with --params random (and neither --plot nor --critic-map)")
-    if not 1 <= args.strokes <= 20:
-        parser.error(f"--strokes must be from 1 to 20, got {args.strokes}")
+    if not 1 <= args.strokes <= MAX_STROKES:
+        parser.error(f"--strokes must be from 1 to {MAX_STROKES}, got {args.strokes}")
     torch.set_num_threads(1)
     if args.strokes != 1:
         return _main_strokes(args, parser)
