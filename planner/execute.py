@@ -31,6 +31,7 @@ from affordplan.errors import AffordplanError, InputError
 from affordplan.geometry import wrap_period
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
+from affordplan.sim.sensor import SENSORS
 from affordplan.sim.simulator import Simulator
 from planner.predict import expected_pose
 from primitives import params as skill_params
@@ -44,6 +45,21 @@ if TYPE_CHECKING:  # type-only: planner.plan imports this module to execute its 
 XY_TOL = STOP_WITHIN  # metres off the plan before replanning: where a push's strokes stop short of their target
 YAW_TOL = MAX_TURN  # radians off the plan before replanning: the most a push's strokes may turn the object
 SPIN_STROKES = 1  # strokes one spin call of a plan may make (1: one stroke per spin step)
+# The clouds a skill of a plan is shown while it acts, by skill; a skill not named sees its policy's own sensor.
+EXECUTION_SENSORS: Mapping[str, str] = {}
+
+
+def check_sensors(sensors: Mapping[str, str] | None) -> dict[str, str]:
+    """``sensors`` (skill -> sensor, :data:`EXECUTION_SENSORS` for ``None``) checked: a dict of known skills and
+    sensors. Raises :class:`InputError` otherwise."""
+    sensors = EXECUTION_SENSORS if sensors is None else sensors
+    if not isinstance(sensors, Mapping):
+        raise InputError(f"sensors must map skills to sensors, got {type(sensors).__name__}")
+    for skill, sensor in sensors.items():
+        if skill not in skill_params.SKILLS or sensor not in SENSORS:
+            raise InputError(f"sensors maps a skill ({', '.join(skill_params.SKILLS)}) to a sensor "
+                             f"({', '.join(SENSORS)}), got {skill!r:.20}: {sensor!r:.20}")
+    return dict(sensors)
 
 
 @dataclass
@@ -193,17 +209,20 @@ def _terminal(out) -> str | None:
 
 def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0,
                  skills: Mapping[str, Skill] | None = None, memory: Planner | None = None,
-                 spin_strokes: int = SPIN_STROKES) -> Execution:
+                 spin_strokes: int = SPIN_STROKES, sensors: Mapping[str, str] | None = None) -> Execution:
     """Run ``plan`` closed-loop (see the module docstring).
 
     ``spin_strokes``: the strokes one spin step may make, re-observing between them (:func:`primitives.strokes.spin_by`
-    for the step's angle); 1, one stroke.
+    for the step's angle); 1, one stroke. ``sensors``: the clouds each named skill is shown while it acts
+    (:meth:`affordplan.sim.simulator.Simulator.seeing`; default :data:`EXECUTION_SENSORS`); the others see the
+    simulator's.
 
     ``skills``: the skills that act (default: the ones the plan was rated with). ``memory``: the planner that replans
     and remembers failures (default: a fork of the plan's planner, :meth:`planner.plan.Planner.fork`), so the plan
     and its planner are left as they were; pass one planner to several executions to let them share what failed.
     """
     spin_strokes = as_whole("spin_strokes", spin_strokes, 1, MAX_STROKES)
+    sensors = check_sensors(sensors)
     planner, goal = memory if memory is not None else plan.planner.fork(), plan.goal
     skills = skills if skills is not None else planner.predictor.skills
     obj = planner.obj
@@ -239,14 +258,16 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
         skill = skills[step.skill]
         strokes, note = 1, ""
         try:
-            if step.skill == "push" and step.strides > 1:
-                made = push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides, step.params["direction"])
-                out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
-            elif step.skill == "spin" and spin_strokes > 1:
-                made = spin_by(skill, sim, step.params["angle"], spin_strokes)
-                out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
-            else:
-                out = skill.execute(sim, step.params)
+            with sim.seeing(sensors.get(step.skill, sim.sensor)):
+                if step.skill == "push" and step.strides > 1:
+                    made = push_to(skill, sim, tuple(step.expected_pose[:2, 3]), step.strides,
+                                   step.params["direction"])
+                    out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
+                elif step.skill == "spin" and spin_strokes > 1:
+                    made = spin_by(skill, sim, step.params["angle"], spin_strokes)
+                    out, strokes, note = made.outcome, made.strokes, f"(strokes: {made.stopped})"
+                else:
+                    out = skill.execute(sim, step.params)
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
             planner.record_failure(step.skill, step.params, T)
             log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc),

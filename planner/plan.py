@@ -547,14 +547,16 @@ class Plan:
         return self.planner.odds(self.steps, budget)
 
     def execute(self, sim: Literal["arm", "finger"] | Simulator = "arm", max_primitives: int = 60,
-                render: bool | str | None = None, seed: int = 0, spin_strokes: int | None = None) -> Execution:
+                render: bool | str | None = None, seed: int = 0, spin_strokes: int | None = None,
+                sensors: Mapping[str, str] | None = None) -> Execution:
         """Run the plan closed-loop (see :mod:`planner.execute`); returns an ``Execution``.
 
         ``sim``: a new simulator with the ``"arm"`` or the bare ``"finger"`` pusher, or a :class:`Simulator` holding
         the plan's object and obstacles; ``render``: a truthy value records a frame per primitive in
         ``Execution.frames``, a string names the camera (default ``"overview"``); ``seed`` seeds a new simulator.
         ``spin_strokes``: strokes one spin step may make (:func:`planner.execute.execute_plan`; default
-        :data:`planner.execute.SPIN_STROKES`).
+        :data:`planner.execute.SPIN_STROKES`). ``sensors``: the clouds each named skill is shown while it acts
+        (:func:`planner.execute.execute_plan`; default :data:`planner.execute.EXECUTION_SENSORS`).
         """
         from planner.execute import SPIN_STROKES, execute_greedy, execute_plan
 
@@ -565,4 +567,4 @@ class Plan:
             return execute_greedy(p.obj, self.goal, self.start_pose, p.predictor, sim=sim, obstacles=p.obstacles,
                                   max_primitives=max_primitives, render=render, seed=seed)
         return execute_plan(self, sim=sim, max_primitives=max_primitives, render=render, seed=seed,
-                            spin_strokes=SPIN_STROKES if spin_strokes is None else spin_strokes)
+                            spin_strokes=SPIN_STROKES if spin_strokes is None else spin_strokes, sensors=sensors)

@@ -94,13 +94,16 @@ def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
     assert "rare goal 1/2" in report.report() and "by what they missed: state 1, yaw 1" in report.report()
 
 
-def test_household_tasks_take_the_unseen_meshes_and_mixed_ones_alternate():
+def test_household_tasks_take_the_unseen_meshes_validation_tasks_the_validation_ones_and_mixed_alternate():
     from affordplan.app.bench.plan import task_object
     from affordplan.objects import housekeep
 
     unseen = {f"housekeep/{n}" for n in housekeep.names("unseen")}
     assert task_object(3, "household").name in unseen
     assert task_object(3, "mixed").name in unseen and task_object(4, "mixed").name.startswith("test_4_")
+    validation = {f"housekeep/{n}" for n in housekeep.names("validation")}
+    assert {task_object(i, "validation").name for i in range(12)} == validation
+    assert not validation & unseen
     with pytest.raises(InputError, match="objects"):
         task_object(0, "kitchen")
 

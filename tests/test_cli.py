@@ -82,6 +82,13 @@ def test_bench_plan_task_indices_must_not_be_negative(capsys):
     assert info.value.code == 2 and "expected a non-negative integer, got -1" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("sensors", ["roll=eyes", "lift=cameras", "roll"])
+def test_bench_plan_refuses_a_sensor_map_it_cannot_read(sensors, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["bench", "plan", "--sensors", sensors])
+    assert info.value.code == 2 and "sensors maps a skill" in capsys.readouterr().err
+
+
 def test_bench_plan_refuses_a_weights_folder_that_is_not_there_before_any_task(capsys, tmp_path):
     assert cli.main(["bench", "plan", "--tasks", "1", "--planner", "affordplan", "--json",
                      "--weights-dir", str(tmp_path / "nowhere")]) == 2

@@ -277,3 +277,31 @@ def test_a_spin_step_of_several_strokes_asks_for_the_rest_of_its_turn_within_one
     assert runs[4].n_primitives == 1 and runs[4].log[0].strokes == 2 and runs[4].replans == 0
     with pytest.raises(ap.errors.InputError, match="spin_strokes"):
         execute_plan(plan, sim=ap.Simulator(cube, seed=0), spin_strokes=0)
+
+
+def test_a_skill_named_in_sensors_acts_on_that_sensors_clouds_and_the_others_on_the_simulators():
+    cube = ap.load_object("cube")
+    T0 = cube.resting_states[0].pose((0.45, 0.0), 0.0)
+    target = skill_params.roll_targets(cube, 0)[0]
+    goal = ap.Goal(xy=(0.6, 0.0), resting_state=target)
+    seen: list[tuple[str, str]] = []
+
+    class Looking(IdealSkill):
+        def execute(self, sim, params):
+            seen.append((self.name, sim.sensor))
+            return super().execute(sim, params)
+
+    skills = {n: Looking(n) for n in ("push", "spin", "roll")}
+    plan = Planner(cube, predictor=StubPredictor(skills), seed=0).plan(T0, goal)
+    assert {s.skill for s in plan.steps} >= {"push", "roll"}
+    sim = ap.Simulator(cube, seed=0, sensor="surface")
+    sim.set_object_pose(T0, settle=False)
+    ex = execute_plan(plan, sim=sim, max_primitives=20, sensors={"roll": "cameras"})
+    assert ex.success, str(ex)
+    assert {sensor for name, sensor in seen if name == "roll"} == {"cameras"}
+    assert {sensor for name, sensor in seen if name != "roll"} == {"surface"}
+    assert sim.sensor == "surface"
+    with pytest.raises(ap.errors.InputError, match="sensors maps"):
+        execute_plan(plan, sim=ap.Simulator(cube, seed=0), sensors={"roll": "eyes"})
+    with pytest.raises(ap.errors.InputError, match="sensors maps"):
+        execute_plan(plan, sim=ap.Simulator(cube, seed=0), sensors={"lift": "cameras"})

@@ -110,3 +110,33 @@ def test_camera_rays_cover_its_field_of_view():
     vertical = np.degrees(np.arctan2(np.abs(dirs[:, 0]), -dirs[:, 2]))  # image up is world +x here
     assert 19 < vertical.max() < 20  # the top row is half a pixel inside the 20 deg half field of view
     assert len(DEFAULT_CAMERAS) >= 3
+
+
+def _off_cube_surface(sim, points):
+    """Each point's distance to the cube's surface along its face, metres (the cube at ``sim``'s pose)."""
+    T = sim.object_pose()
+    q = (points - T[:3, 3]) @ T[:3, :3]
+    return np.abs(np.max(np.abs(q), axis=1) - 0.5 * sim.obj.mesh.extents[0])
+
+
+def test_a_simulator_shows_another_sensors_clouds_inside_seeing_and_its_own_after():
+    cube = ap.load_object("cube")
+    sim = ap.Simulator(cube, seed=0, sensor="surface")
+    sim.reset(0, xy=(0.5, 0.0), yaw=0.0)
+    with sim.seeing("cameras") as seen:
+        assert seen is sim and sim.sensor == "cameras"
+        cameras, _ = sim.point_cloud(1024)
+    assert sim.sensor == "surface"
+    surface, _ = sim.point_cloud(1024)
+    assert np.median(_off_cube_surface(sim, cameras)) > 2e-4  # range noise: the cameras' cloud
+    assert np.max(_off_cube_surface(sim, surface)) < 2e-3  # the exact surface again
+    camera_sim = ap.Simulator(cube, seed=0)
+    camera_sim.reset(0, xy=(0.5, 0.0), yaw=0.0)
+    with camera_sim.seeing("surface"):
+        assert np.max(_off_cube_surface(camera_sim, camera_sim.point_cloud(512)[0])) < 2e-3
+    assert camera_sim.sensor == "cameras"
+    assert np.median(_off_cube_surface(camera_sim, camera_sim.point_cloud(512)[0])) > 2e-4
+    with pytest.raises(InputError, match="unknown sensor"):
+        with sim.seeing("lidar"):
+            pass
+    assert sim.sensor == "surface"

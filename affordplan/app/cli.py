@@ -152,7 +152,7 @@ def _cmd_bench_plan(args: argparse.Namespace) -> int:
                         max_primitives=args.max_primitives, progress=not args.json and not args.log,
                         only=args.task, log=log, weights_dir=args.weights_dir, draw=args.draw,
                         objects=args.objects, max_strides=args.max_strides or MAX_STRIDES,
-                        spin_strokes=args.spin_strokes)
+                        spin_strokes=args.spin_strokes, sensors=args.sensors)
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.report())
     return 0
 
@@ -296,6 +296,18 @@ def _bounded_float(low: float, high: float, what: str):
 
 def _positive_int(text: str) -> int:
     return _int_at_least(text, 1, "positive")
+
+
+def _skill_sensors(text: str) -> dict[str, str]:
+    """``SKILL=SENSOR[,SKILL=SENSOR...]`` as a dict (:func:`planner.execute.check_sensors`)."""
+    from affordplan.errors import InputError
+    from planner.execute import check_sensors
+
+    pairs = [item.partition("=") for item in text.split(",") if item]
+    try:
+        return check_sensors({skill.strip(): sensor.strip() for skill, _, sensor in pairs})
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 MAX_WIDTH, MAX_HEIGHT = 1280, 960  # the scene's offscreen buffer (affordplan.sim.scene)
@@ -525,10 +537,12 @@ def build_parser() -> argparse.ArgumentParser:
     bp.add_argument("--draw", type=_nonnegative_int, default=0, metavar="K",
                     help="run the same tasks with the planner's and the simulator's random numbers drawn afresh "
                          "(K > 0; 0, the default, is the standard run): how far outcomes move by chance alone")
-    bp.add_argument("--objects", default="procedural", choices=["procedural", "household", "mixed", "training"],
+    bp.add_argument("--objects", default="procedural",
+                    choices=["procedural", "household", "mixed", "training", "validation"],
                     help="the tasks' objects: the procedural test split, HACMan's 25 unseen household meshes, or "
                          "the two by turns; training: the training objects by turns, for fitting the planner's "
-                         "stuck rates, never for reporting (default: %(default)s)")
+                         "stuck rates; validation: the 12 household validation meshes, for choosing settings; "
+                         "neither for reporting (default: %(default)s)")
     bp.add_argument("--max-strides", type=_positive_int, default=None, metavar="K",
                     help="5 cm strides one push call may make, correcting its course between strokes; 1: one "
                          "stroke per push, as until 0.24 (default: the planner's, planner.plan.MAX_STRIDES)")
@@ -536,6 +550,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="strokes one spin step may make, asking for the rest of its turn between them "
                          "(primitives.strokes.spin_by); 1: one stroke per spin (default: "
                          "planner.execute.SPIN_STROKES)")
+    bp.add_argument("--sensors", type=_skill_sensors, default=None, metavar="SKILL=SENSOR[,...]",
+                    help="the clouds a skill of the plans is shown while it acts, e.g. roll=cameras (default: "
+                         "planner.execute.EXECUTION_SENSORS; a skill not named sees its policy's own)")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.set_defaults(func=_cmd_bench_plan)
     bf = bench_sub.add_parser(

@@ -14,7 +14,8 @@ updated and the guards run once per chunk (every 20 ms), so no Python runs per p
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import mujoco
@@ -261,6 +262,25 @@ class Simulator:
                 raise PerceptionError("no camera sees the object (hidden behind obstacles or the arm)")
             return points, normals
         return surface_cloud(self._samples_obj, self._normals_obj, self.object_pose(), self._rng, n)
+
+    @contextmanager
+    def seeing(self, sensor: str) -> Iterator[Simulator]:
+        """This simulator showing ``sensor``'s clouds (:meth:`point_cloud`) inside the ``with`` block, and its own
+        sensor again after it: e.g. one skill of a plan looking through the cameras its ratings were fitted to while
+        the others see the surface sample. The physics and the random generator are the simulator's own.
+
+        Raises:
+            InputError: an unknown sensor.
+        """
+        if sensor not in SENSORS:
+            raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
+        before = self.sensor, self._camera
+        self.sensor = sensor
+        self._camera = None if sensor == "surface" else before[1] or CameraSensor(self.model, self._object_body)
+        try:
+            yield self
+        finally:
+            self.sensor, self._camera = before
 
     def surface_normal(self, point_world: np.ndarray) -> np.ndarray:
         """Outward normal (world frame) of the surface sample nearest to ``point_world``."""

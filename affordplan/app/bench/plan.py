@@ -17,7 +17,7 @@ import math
 import os
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 
 import networkx as nx
@@ -31,6 +31,7 @@ from affordplan.objects import housekeep
 from affordplan.objects.model import ObjectModel, load_object, random_object
 from affordplan.robot import SKILLS
 from affordplan.world import Box, Workspace
+from planner.execute import check_sensors
 from planner.graph import RestingStateGraph
 from planner.plan import CLEARANCE, MAX_STRIDES, inflated_footprints, make_checkers
 from planner.predict import Predictor
@@ -45,7 +46,7 @@ RARE_GOAL_STATE = 0.05
 # housekeep.names("unseen")), or the two by turns (even tasks procedural, odd ones household); "training": the
 # training objects by turns (procedural train split, housekeep.names("training")), for fitting what the planner
 # learns from plan outcomes (planner.odds.STUCK_RATES), never for reporting.
-OBJECT_SETS = ("procedural", "household", "mixed", "training")
+OBJECT_SETS = ("procedural", "household", "mixed", "training", "validation")
 
 
 @dataclass
@@ -174,9 +175,14 @@ def _scene(rng: np.random.Generator, kind: str, radius: float) -> tuple[Box, ...
 def task_object(index: int, objects: str = "procedural") -> ObjectModel:
     """Task ``index``'s object (:data:`OBJECT_SETS`): procedural test object ``index``, or unseen household mesh
     ``index`` (cycling through the 25); ``"mixed"`` takes the household one for odd indices; ``"training"`` as
-    ``"mixed"`` from the training objects (procedural train split, household training meshes)."""
+    ``"mixed"`` from the training objects (procedural train split, household training meshes); ``"validation"``
+    household validation mesh ``index`` (cycling through the 12 carved out of HACMan's train split), for choosing
+    settings on objects the test figures do not use."""
     if objects not in OBJECT_SETS:
         raise InputError(f"objects must be one of {OBJECT_SETS}, got {str(objects)[:40]!r}")
+    if objects == "validation":
+        names = housekeep.names("validation")
+        return load_object(f"housekeep/{names[index % len(names)]}")
     if objects == "household" or (objects in ("mixed", "training") and index % 2):
         names = housekeep.names("training" if objects == "training" else "unseen")
         return load_object(f"housekeep/{names[index % len(names)]}")
@@ -235,10 +241,11 @@ def plan_calibration(predicted: Sequence[float], reached: Sequence[bool], bins: 
 
 def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predictor: Predictor, seed: int,
              max_primitives: int, time_limit: float, log: Callable[[str], None] | None = None,
-             max_strides: int = MAX_STRIDES, spin_strokes: int | None = None) -> TaskResult:
+             max_strides: int = MAX_STRIDES, spin_strokes: int | None = None,
+             sensors: Mapping[str, str] | None = None) -> TaskResult:
     """Plan and execute ``task`` with one planner; ``log``, when given, receives the first plan and the
     execution's step log (:class:`planner.execute.Execution`) as text. ``max_strides``: as
-    :func:`planner.api.plan`; ``spin_strokes``: as :meth:`planner.plan.Plan.execute`."""
+    :func:`planner.api.plan`; ``spin_strokes``, ``sensors``: as :meth:`planner.plan.Plan.execute`."""
     from planner.api import plan as make_plan
 
     p_goal = float(obj.resting_states[task.goal.resting_state].probability)
@@ -251,7 +258,7 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
             log(f"{planner_name}: no plan: {exc}")
         return TaskResult(planner_name, task.scene, False, time.perf_counter() - t0, 0, 0, f"no plan: {exc}",
                           p_goal, missed="no plan")
-    ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed, spin_strokes=spin_strokes)
+    ex = p.execute(sim=sim, max_primitives=max_primitives, seed=seed, spin_strokes=spin_strokes, sensors=sensors)
     if log is not None:
         log(f"{planner_name}: {p}\n{ex}")
     first = p.planning_time if planner_name == "affordplan" else ex.planning_time / max(1, ex.n_primitives)
@@ -292,7 +299,8 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
                max_primitives: int = 40, time_limit: float = 5.0, progress: bool = True,
                only: Sequence[int] | None = None, log: Callable[[str], None] | None = None,
                weights_dir: str | os.PathLike | None = None, draw: int = 0, objects: str = "procedural",
-               max_strides: int = MAX_STRIDES, spin_strokes: int | None = None) -> BenchReport:
+               max_strides: int = MAX_STRIDES, spin_strokes: int | None = None,
+               sensors: Mapping[str, str] | None = None) -> BenchReport:
     """Run ``n_tasks`` random tasks with each planner (see the module docstring).
 
     ``draw``: 0 runs the standard bench; ``k > 0`` runs the same tasks (objects, scenes, starts, goals) with the
@@ -309,7 +317,8 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     ``max_strides``: the 5 cm strides one push call of the affordplan planner may make (:func:`planner.api.plan`);
     1 benches pushes of one stroke each, as until 0.24. ``spin_strokes``: the strokes one spin step of the affordplan
     planner's plans may make (:meth:`planner.plan.Plan.execute`; default :data:`planner.execute.SPIN_STROKES`). Each
-    task reports its calls (``primitives``) and its fingertip strokes.
+    task reports its calls (``primitives``) and its fingertip strokes. ``sensors``: the clouds each named skill of
+    the affordplan planner's plans is shown while it acts (default :data:`planner.execute.EXECUTION_SENSORS`).
 
     ``only``: run just these tasks of the seed's draw (indices; the same tasks, objects and scenes as in the whole
     run, which draws them in order). ``log``: receives, per task and planner, a header, the first plan and the
@@ -323,6 +332,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
     wanted = range(n_tasks) if only is None else sorted(set(only))
     if not wanted or not all(0 <= i < OBJECTS_PER_SEED for i in wanted):
         raise InputError(f"task indices must be 0-{OBJECTS_PER_SEED - 1}, got {list(only or [])}")
+    sensors = check_sensors(sensors)
     skills = None if weights_dir is None else load_skills(weights_dir)
     rng = np.random.default_rng(seed)
     report = BenchReport(draw=draw, objects=objects, max_primitives=max_primitives, seed=seed)
@@ -337,7 +347,7 @@ def bench_plan(n_tasks: int = 50, sim: str = "arm", seed: int = 0, planners=("af
             if log is not None:
                 log(f"=== seed {seed} task {i}: {obj.name} ({task.scene}); {_describe(task)}")
             result = run_task(task, obj, name, sim, predictor, task_seed(seed, i, draw), max_primitives, time_limit,
-                              log, max_strides, spin_strokes)
+                              log, max_strides, spin_strokes, sensors)
             result.task = i
             report.results.append(result)
         bar.update(1)
