@@ -27,6 +27,13 @@ from affordplan.errors import InputError
 from affordplan.robot import TABLE_CONTACT_HEIGHT
 
 SENSORS = ("cameras", "surface")
+
+
+def check_sensor(sensor: str) -> str:
+    """``sensor`` if it names one of :data:`SENSORS`; raises :class:`InputError` otherwise."""
+    if sensor not in SENSORS:
+        raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
+    return sensor
 NORMAL_NEIGHBOURS = 12  # points in each normal's PCA neighbourhood
 
 

@@ -31,7 +31,7 @@ from affordplan.sim.arm import HOME, ArmIK
 from affordplan.sim.guards import GuardLimits, PhysicsGuard
 from affordplan.sim.pushers import ArmPusher, FingerPusher
 from affordplan.sim.scene import OBJECT_BODY, PUSHERS, build_mjcf, set_free_pose
-from affordplan.sim.sensor import SENSORS, TABLE_CONTACT_HEIGHT, CameraSensor, surface_cloud
+from affordplan.sim.sensor import TABLE_CONTACT_HEIGHT, CameraSensor, check_sensor, surface_cloud
 from affordplan.world import Box, Workspace
 
 MAX_COORDINATE = 10.0  # metres: no contact, normal or motion component is larger
@@ -115,8 +115,7 @@ class Simulator:
     ):
         if pusher not in PUSHERS:
             raise InputError(f"unknown pusher {pusher!r}; expected one of {PUSHERS}")
-        if sensor not in SENSORS:
-            raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
+        check_sensor(sensor)
         if not isinstance(obj, ObjectModel):
             raise InputError(f"obj must be an ObjectModel (see affordplan.load_object), got {type(obj).__name__}")
         seed = as_seed("seed", seed)
@@ -272,8 +271,7 @@ class Simulator:
         Raises:
             InputError: an unknown sensor.
         """
-        if sensor not in SENSORS:
-            raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
+        check_sensor(sensor)
         before = self.sensor, self._camera
         self.sensor = sensor
         self._camera = None if sensor == "surface" else before[1] or CameraSensor(self.model, self._object_body)

@@ -46,7 +46,7 @@ from pathlib import Path
 
 from affordplan.errors import AffordplanError, InputError, WeightsError
 from affordplan.log import cli_logging, one_line_errors
-from affordplan.sim.sensor import SENSORS
+from affordplan.sim.sensor import SENSORS, check_sensor
 from primitives import weights_file
 from primitives.frames import FrameSearch
 from primitives.training.env import PRIMITIVES
@@ -130,8 +130,8 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
     """
     from primitives.skills import load_skill
 
-    if sensor is not None and sensor not in SENSORS:
-        raise InputError(f"unknown sensor {sensor!r}; expected one of {SENSORS}")
+    if sensor is not None:
+        check_sensor(sensor)
     if skill not in PRIMITIVES:
         raise InputError(f"unknown skill {skill!r}; expected one of {PRIMITIVES}")
     source = Path(source)

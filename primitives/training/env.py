@@ -27,7 +27,7 @@ from affordplan.checks import require_probability, require_whole
 from affordplan.errors import InputError
 from affordplan.objects import housekeep
 from affordplan.objects.model import ObjectModel, load_object, random_object
-from affordplan.sim.sensor import SENSORS
+from affordplan.sim.sensor import check_sensor
 from affordplan.sim.simulator import Outcome, Simulator
 from primitives import params as skill_params
 from primitives import rewards
@@ -89,8 +89,7 @@ def check_env_config(config: EnvConfig) -> None:
     for name, low in least.items():
         require_whole(f"EnvConfig.{name}", getattr(config, name), low)
     require_probability("EnvConfig.p_params", config.p_params)
-    if config.sensor not in SENSORS:
-        raise InputError(f"unknown sensor {config.sensor!r}; expected one of {SENSORS}")
+    check_sensor(config.sensor)
     object_groups(config.objects, config.n_objects)
 
 
