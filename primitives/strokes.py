@@ -94,26 +94,28 @@ def _combined(first: Outcome, last: Outcome, success: bool) -> Outcome:
 
 
 def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], strides: int,
-            direction: float | None = None) -> Strokes:
+            direction: float | None = None, max_turn: float = MAX_TURN) -> Strokes:
     """Push the object in ``sim`` to ``target_xy`` (world, metres) with up to ``strides + EXTRA_STROKES`` strokes
     of the push ``skill``, observing before each (module docstring).
 
     ``direction``: the first stroke's heading (radians; default: towards the target); later strokes aim at the
-    target from where the object lies. The call ends after a stroke that left the object's resting state, turned
-    it more than ``MAX_TURN`` in all, did not move it ``MIN_PUSH_PROGRESS`` its way (a stroke that fails once here
+    target from where the object lies. ``max_turn``: the most the strokes may turn the object in all (radians,
+    ``MAX_TURN`` by default). The call ends after a stroke that left the object's resting state, turned it more than
+    ``max_turn`` in all, did not move it ``MIN_PUSH_PROGRESS`` its way (a stroke that fails once here
     fails again: the cloud is the same), or carried it past the target; after an invalid stroke; and within
     ``STOP_WITHIN`` of the target. An error in a later stroke (no contact the arm can reach) ends the call with
     the strokes made; in the first, it is raised. ``Strokes.outcome.success``: the object ended within
     ``STOP_WITHIN`` of the target in its resting state, validly.
 
     Raises:
-        InputError: a target that is not two finite numbers, ``strides`` not a whole number from 1 to 100, or a
-            skill that is not the push.
+        InputError: a target that is not two finite numbers, ``strides`` not a whole number from 1 to 100,
+            ``max_turn`` not in (0, pi], or a skill that is not the push.
     """
     if skill.name != "push":
         raise InputError(f"push_to takes the push skill, got {skill.name!r}")
     target = as_vector("target_xy (m)", target_xy, 2)
     strides = as_whole("strides", strides, 1, 100)
+    max_turn = as_finite("max_turn (rad)", max_turn, 1e-6, math.pi)
     obj = sim.obj
     state, x0, y0, yaw0 = obj.planar_pose(sim.object_pose())
     heading0 = math.atan2(target[1] - y0, target[0] - x0)
@@ -128,7 +130,7 @@ def push_to(skill: Skill, sim: Simulator, target_xy: tuple[float, float], stride
         s1, x1, y1, yaw1 = obj.planar_pose(out.pose_after)
         if s1 != state:
             return "left its resting state"
-        if abs(float(wrap_angle(yaw1 - yaw0))) > MAX_TURN:
+        if abs(float(wrap_angle(yaw1 - yaw0))) > max_turn:
             return "turned"
         if not made_progress(obj, "push", {"direction": asked[-1]}, out.pose_before, out.pose_after):
             return "did not move"

@@ -65,17 +65,24 @@ def test_a_stroke_that_does_not_move_the_object_ends_the_call(sim):
     assert made.strokes == 1 and made.stopped == "did not move" and not made.outcome.success
 
 
-def test_a_stroke_that_turns_the_object_ends_the_call(sim):
-    class Turning(IdealSkill):
-        def execute(self, sim, params):
-            out = super().execute(sim, params)
-            T1 = out.pose_after.copy()
-            T1[:3, :3] = rot_z(math.radians(30.0)) @ T1[:3, :3]
-            sim.set_object_pose(T1, settle=False)
-            out.pose_after = T1
-            return out
+class Turning(IdealSkill):
+    """An ideal push whose every stroke also turns the object ``turn`` radians about world +z."""
 
-    made = push_to(Turning("push"), sim, (0.57, 0.0), strides=3)
+    def __init__(self, turn: float):
+        super().__init__("push")
+        self.turn = turn
+
+    def execute(self, sim, params):
+        out = super().execute(sim, params)
+        T1 = out.pose_after.copy()
+        T1[:3, :3] = rot_z(self.turn) @ T1[:3, :3]
+        sim.set_object_pose(T1, settle=False)
+        out.pose_after = T1
+        return out
+
+
+def test_a_stroke_that_turns_the_object_ends_the_call(sim):
+    made = push_to(Turning(math.radians(30.0)), sim, (0.57, 0.0), strides=3)
     assert made.strokes == 1 and made.stopped == "turned" and not made.outcome.success
 
 
@@ -234,3 +241,14 @@ def test_roll_to_refuses_a_state_not_one_roll_away_and_other_skills(sim):
         roll_to(IdealSkill("roll"), sim, 99)
     with pytest.raises(InputError, match="roll skill"):
         roll_to(IdealSkill("spin"), sim, roll_targets(sim.obj, here)[0])
+
+
+def test_a_push_may_be_let_turn_the_object_further(sim):
+    default = push_to(Turning(math.radians(20.0)), sim, (0.62, 0.0), strides=4)
+    assert default.strokes == 1 and default.stopped == "turned"  # 20 deg > MAX_TURN (12 deg)
+    sim.set_object_pose(sim.obj.resting_states[0].pose((0.42, 0.0), 0.0), settle=False)
+    loose = push_to(Turning(math.radians(20.0)), sim, (0.62, 0.0), strides=4, max_turn=math.radians(45.0))
+    assert loose.strokes == 3 and loose.stopped == "turned"  # 60 deg after the third stroke
+    for bad in (0.0, -0.1, 4.0, math.nan):
+        with pytest.raises(InputError):
+            push_to(IdealSkill("push"), sim, (0.57, 0.0), strides=2, max_turn=bad)
