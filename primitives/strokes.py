@@ -44,7 +44,7 @@ if TYPE_CHECKING:
 
 EXTRA_STROKES = 1  # strokes a call may take beyond its strides (one stroke that fell short)
 STOP_WITHIN = 0.025  # metres from the target at which the strokes stop (the executor replans past it: XY_TOL)
-MAX_TURN = math.radians(12.0)  # turning the object more than this ends the call (the executor's YAW_TOL is it)
+MAX_TURN = math.radians(12.0)  # push_to's default max_turn: the call ends past this turn (the executor's YAW_TOL)
 MAX_STROKES = 20  # the most strokes one call may be given
 
 
