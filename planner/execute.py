@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -193,6 +193,13 @@ def _record_frame(sim: Simulator, render, frames: list[np.ndarray]) -> None:
         frames.append(f)
 
 
+def _logged(log: list[LogEntry], entry: LogEntry, on_primitive: Callable[[LogEntry], None] | None) -> None:
+    """Append ``entry`` to ``log`` and tell ``on_primitive`` (when given) that its primitive is done."""
+    log.append(entry)
+    if on_primitive is not None:
+        on_primitive(entry)
+
+
 # Guard faults after which the object cannot be manipulated any further: it hangs on the pusher or lies on
 # an obstacle, it left the workspace, or the physics broke down.
 TERMINAL_FAULTS = ("off_table", "left_workspace", "nan", "unstable")
@@ -214,7 +221,8 @@ def _terminal(out) -> str | None:
 
 def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: int = 0,
                  skills: Mapping[str, Skill] | None = None, memory: Planner | None = None,
-                 spin_strokes: int = SPIN_STROKES, sensors: Mapping[str, str] | None = None) -> Execution:
+                 spin_strokes: int = SPIN_STROKES, sensors: Mapping[str, str] | None = None,
+                 on_primitive: Callable[[LogEntry], None] | None = None) -> Execution:
     """Run ``plan`` closed-loop (see the module docstring).
 
     ``spin_strokes``: the strokes one spin step may make, re-observing between them (:func:`primitives.strokes.spin_by`
@@ -225,6 +233,8 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
     ``skills``: the skills that act (default: the ones the plan was rated with). ``memory``: the planner that replans
     and remembers failures (default: a fork of the plan's planner, :meth:`planner.plan.Planner.fork`), so the plan
     and its planner are left as they were; pass one planner to several executions to let them share what failed.
+    ``on_primitive``: called with each primitive's :class:`LogEntry` as soon as the primitive is done (a progress
+    bar, a frame after each primitive; a push of several strides is one primitive).
     """
     spin_strokes = as_whole("spin_strokes", spin_strokes, 1, MAX_STROKES)
     sensors = check_sensors(sensors)
@@ -275,16 +285,15 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
                     out = skill.execute(sim, step.params)
         except AffordplanError as exc:  # e.g. a roll target not one roll away from the observed state
             planner.record_failure(step.skill, step.params, T)
-            log.append(LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success, str(exc),
-                                _states(obj, T)))
+            _logged(log, LogEntry(n, step.skill, step.params, False, False, T, T, replanned, step.p_success,
+                                  str(exc), _states(obj, T)), on_primitive)
             k = len(steps)
             continue
         if not made_progress(obj, step.skill, step.params, out.pose_before, out.pose_after):
             planner.record_failure(step.skill, step.params, T)
-        log.append(LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
-                            out.pose_after, replanned, step.p_success, note, _states(obj, out.pose_before,
-                                                                                      out.pose_after),
-                            strokes=strokes))
+        _logged(log, LogEntry(n, step.skill, step.params, bool(out.success), out.valid, out.pose_before,
+                              out.pose_after, replanned, step.p_success, note,
+                              _states(obj, out.pose_before, out.pose_after), strokes=strokes), on_primitive)
         _record_frame(sim, render, frames)
         if (stop := _terminal(out)) is not None:
             reason = stop
@@ -309,8 +318,9 @@ def greedy_calls(obj: ObjectModel, state: int) -> list[tuple[str, dict]]:
 
 
 def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor, sim="arm", obstacles=(),
-                   max_primitives: int = 60, render=None, seed: int = 0) -> Execution:
-    """The greedy baseline (see the module docstring)."""
+                   max_primitives: int = 60, render=None, seed: int = 0,
+                   on_primitive: Callable[[LogEntry], None] | None = None) -> Execution:
+    """The greedy baseline (see the module docstring); ``on_primitive`` as for :func:`execute_plan`."""
     sim = _simulator(sim, obj, obstacles, T_start, seed, skills_sensor(predictor.skills))
     log: list[LogEntry] = []
     frames: list[np.ndarray] = []
@@ -336,11 +346,12 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
         try:
             out = predictor.skills[skill_name].execute(sim, prm)
         except AffordplanError as exc:  # e.g. ReachabilityError: the arm cannot reach the chosen contact
-            log.append(LogEntry(n, skill_name, prm, False, False, T, T, False, float(p[best]), str(exc),
-                                _states(obj, T)))
+            _logged(log, LogEntry(n, skill_name, prm, False, False, T, T, False, float(p[best]), str(exc),
+                                  _states(obj, T)), on_primitive)
             continue
-        log.append(LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
-                            False, float(p[best]), states=_states(obj, out.pose_before, out.pose_after)))
+        _logged(log, LogEntry(n, skill_name, prm, bool(out.success), out.valid, out.pose_before, out.pose_after,
+                              False, float(p[best]), states=_states(obj, out.pose_before, out.pose_after)),
+                on_primitive)
         _record_frame(sim, render, frames)
         if (stop := _terminal(out)) is not None:
             reason = stop

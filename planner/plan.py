@@ -31,7 +31,7 @@ import copy
 import math
 import time
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
@@ -57,7 +57,7 @@ from primitives.params import PARAMS_TYPES, SkillName, SkillParams, as_params
 
 if TYPE_CHECKING:  # planner.execute imports this module's Planner; Plan.execute imports it when called
     from affordplan.sim.simulator import Simulator
-    from planner.execute import Execution
+    from planner.execute import Execution, LogEntry
 
 SPLIT_ANGLE = math.radians(35.0)
 # Turns tried, in order, on each side of a push that failed twice (the first is SPLIT_ANGLE): each detour
@@ -548,7 +548,8 @@ class Plan:
 
     def execute(self, sim: Literal["arm", "finger"] | Simulator = "arm", max_primitives: int = 60,
                 render: bool | str | None = None, seed: int = 0, spin_strokes: int | None = None,
-                sensors: Mapping[str, str] | None = None) -> Execution:
+                sensors: Mapping[str, str] | None = None,
+                on_primitive: Callable[[LogEntry], None] | None = None) -> Execution:
         """Run the plan closed-loop (see :mod:`planner.execute`); returns an ``Execution``.
 
         ``sim``: a new simulator with the ``"arm"`` or the bare ``"finger"`` pusher, or a :class:`Simulator` holding
@@ -557,6 +558,7 @@ class Plan:
         ``spin_strokes``: strokes one spin step may make (:func:`planner.execute.execute_plan`; default
         :data:`planner.execute.SPIN_STROKES`). ``sensors``: the clouds each named skill is shown while it acts
         (:func:`planner.execute.execute_plan`; default :data:`planner.execute.EXECUTION_SENSORS`).
+        ``on_primitive``: called with each primitive's :class:`~planner.execute.LogEntry` as soon as it is done.
         """
         from planner.execute import SPIN_STROKES, execute_greedy, execute_plan
 
@@ -565,6 +567,7 @@ class Plan:
         if self.kind == "greedy":
             p = self.planner
             return execute_greedy(p.obj, self.goal, self.start_pose, p.predictor, sim=sim, obstacles=p.obstacles,
-                                  max_primitives=max_primitives, render=render, seed=seed)
+                                  max_primitives=max_primitives, render=render, seed=seed, on_primitive=on_primitive)
         return execute_plan(self, sim=sim, max_primitives=max_primitives, render=render, seed=seed,
-                            spin_strokes=SPIN_STROKES if spin_strokes is None else spin_strokes, sensors=sensors)
+                            spin_strokes=SPIN_STROKES if spin_strokes is None else spin_strokes, sensors=sensors,
+                            on_primitive=on_primitive)

@@ -38,3 +38,29 @@ def test_run_scene_refuses_a_primitive_budget_that_is_not_a_whole_number(max_pri
     with pytest.raises(InputError, match="max_primitives must be a whole number >= 1"):
         run_scene(demo_scene(), tmp_path, max_primitives=max_primitives, video=False, progress=False)
     assert not any(tmp_path.iterdir())  # refused before anything was written
+
+
+def test_the_demos_key_frames_are_labelled_by_primitive_a_push_of_several_strokes_as_one():
+    """frames.png's labels count primitives (what the execution log counts), not the strokes a push makes."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    import affordplan as ap
+    from affordplan.app.demo import _Watch
+    from planner.execute import LogEntry
+
+    cube = ap.load_object("cube")
+    sim = ap.Simulator(cube, seed=0)
+    T = sim.reset(0, (0.5, 0.0), 0.0)
+    recorder = SimpleNamespace(take=lambda: (lambda: None), frames=[])
+    watch = _Watch(cube, sim, recorder, max_primitives=5, label="finger", progress=False)
+    sim.physics_steps += 300  # three strokes of one push
+    watch.after_primitive(LogEntry(0, "push", {"direction": 0.0}, True, True, T, T, strokes=3))
+    watch.after_primitive(LogEntry(1, "roll", {"target": 1}, False, False, T, T))  # refused: nothing simulated
+    sim.physics_steps += 100
+    watch.after_primitive(LogEntry(2, "spin", {"angle": 0.5}, True, True, T, T))
+    assert [label for label, _ in watch.keyframes] == ["start", "after primitive 1, 3 strokes", "after primitive 3"]
+    assert watch.executed == 3 and not watch.off_table
+    assert np.allclose(sim.object_pose(), T, atol=1e-3)
+    watch.close()

@@ -251,6 +251,25 @@ def test_a_push_of_several_strides_is_one_primitive_of_several_strokes():
     assert "strokes" in str(runs[4])
 
 
+def test_on_primitive_is_told_each_primitive_once_in_order_a_push_of_several_strides_as_one():
+    from planner.execute import execute_greedy
+
+    cube = ap.load_object("cube")
+    T0, goal = cube.resting_states[0].pose((0.40, -0.1), 0.0), ap.Goal(xy=(0.70, 0.1))
+    skills = {n: IdealSkill(n) for n in ("push", "spin", "roll")}
+    plan = Planner(cube, predictor=StubPredictor(skills), seed=0, max_strides=4).plan(T0, goal)
+    sim = ap.Simulator(cube, seed=0)
+    sim.set_object_pose(T0, settle=False)
+    told = []
+    ex = execute_plan(plan, sim=sim, max_primitives=30, on_primitive=told.append)
+    assert ex.success and len(told) == ex.n_primitives and all(a is b for a, b in zip(told, ex.log))
+    assert any(e.strokes > 1 for e in told)
+    sim.set_object_pose(T0, settle=False)
+    told = []
+    greedy = execute_greedy(cube, goal, T0, StubPredictor(skills), sim=sim, max_primitives=15, on_primitive=told.append)
+    assert told and all(a is b for a, b in zip(told, greedy.log)) and len(told) == greedy.n_primitives
+
+
 class HalfSpin(IdealSkill):
     """A spin that turns the object half the asked angle (a real policy's turn follows its ask loosely)."""
 

@@ -35,62 +35,51 @@ from affordplan.errors import InputError
 from affordplan.geometry import transform_points
 from affordplan.goal import Goal
 from affordplan.objects.model import ObjectModel
-from affordplan.sim.simulator import Outcome, Simulator
+from affordplan.sim.simulator import Simulator
 
 DEMO_MAX_PRIMITIVES = 30  # bounds the demo's time: ~1-3 s per arm primitive with frames on 2 cores
 END_HOLD_S = 1.0  # the video holds its last frame this long
 OFF_TABLE_HEIGHT = 0.01  # metres: a settled object whose lowest point is higher than this is not on the table
 
 if TYPE_CHECKING:  # the planner is imported lazily (affordplan core <- primitives <- planner)
-    from planner.execute import Execution
+    from planner.execute import Execution, LogEntry
     from planner.plan import Plan
 
 
-class _NotifyingSimulator(Simulator):
-    """A :class:`Simulator` that calls ``after_primitive(self)`` after every :meth:`execute`, even a failed one."""
-
-    after_primitive: Callable[[Simulator], None] | None = None
-
-    def execute(self, contact, motion, normal=None) -> Outcome:
-        try:
-            return super().execute(contact, motion, normal=normal)
-        finally:
-            if self.after_primitive is not None:
-                self.after_primitive(self)
-
-
 class _Watch:
-    """Bookkeeping after every primitive: the progress bar, key frames, and whether the object left the table.
+    """Bookkeeping after every primitive (a push of several strides is one): the progress bar, key frames, and
+    whether the object left the table.
 
     Key frames (for ``frames.png``) are taken after primitives that simulated anything: a call the
     arm could not reach adds none.
     """
 
-    def __init__(self, obj: ObjectModel, recorder: FrameRecorder | None, max_primitives: int, label: str,
-                 progress: bool):
+    def __init__(self, obj: ObjectModel, sim: Simulator, recorder: FrameRecorder | None, max_primitives: int,
+                 label: str, progress: bool):
         from tqdm import tqdm
 
+        self.sim = sim
         self.recorder = recorder
         self.hull = obj.hull.vertices
         self.executed = 0
         self.off_table: list[tuple[int, float]] = []
         self.keyframes: list[tuple[str, Callable[[], np.ndarray | None]]] = []  # drawn in the background
-        self._steps_seen = -1
-        self.bar = tqdm(total=max_primitives, desc=f"executing ({label})", unit="prim", disable=not progress)
-
-    def start(self, sim: Simulator) -> None:
         self._steps_seen = sim.physics_steps
-        if self.recorder is not None and (f := self.recorder.take()) is not None:
+        self.bar = tqdm(total=max_primitives, desc=f"executing ({label})", unit="prim", disable=not progress)
+        if recorder is not None and (f := recorder.take()) is not None:
             self.keyframes.append(("start", f))
 
-    def after_primitive(self, sim: Simulator) -> None:
+    def after_primitive(self, entry: LogEntry) -> None:
+        """What :func:`planner.execute.execute_plan` calls after each primitive (``entry``: its log line)."""
+        sim = self.sim
         self.executed += 1
         lowest = float(np.min(transform_points(sim.object_pose(), self.hull)[:, 2]))
         if lowest > OFF_TABLE_HEIGHT:
             self.off_table.append((self.executed, lowest))
         if self.recorder is not None:
             if sim.physics_steps > self._steps_seen and (f := self.recorder.take()) is not None:
-                self.keyframes.append((f"after primitive {self.executed}", f))
+                strokes = f", {entry.strokes} strokes" if entry.strokes > 1 else ""
+                self.keyframes.append((f"after primitive {self.executed}{strokes}", f))
             self.bar.set_postfix(frames=len(self.recorder.frames), refresh=False)
         self._steps_seen = sim.physics_steps
         self.bar.update(1)
@@ -209,7 +198,7 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
     from primitives.skills import skills_sensor
 
     sensor = skills_sensor(plan.planner.predictor.skills)  # the clouds the shipped skills were trained on
-    simulator = _NotifyingSimulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed, sensor=sensor)
+    simulator = Simulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed, sensor=sensor)
     simulator.set_object_pose(plan.start_pose)
     camera = camera or ("arm" if sim == "arm" else "overview")
     recorder = FrameRecorder(simulator, width, height, camera, frame_interval, quality=quality) if video else None
@@ -220,14 +209,13 @@ def run_scene(scene: Scene, out_dir: str | Path, *, sim: str = "arm", planner: s
         live = open_viewer(simulator, echo=echo)
     simulator.on_chunk = chain_hooks(recorder.on_chunk if recorder else None, live.on_chunk if live else None)
     echo(f"executing in the {sim} sim (at most {max_primitives} primitives) ...")
-    watch = _Watch(obj, recorder, max_primitives, sim, progress)
-    watch.start(simulator)
-    simulator.after_primitive = watch.after_primitive
+    watch = _Watch(obj, simulator, recorder, max_primitives, sim, progress)
     try:
-        execution = plan.execute(sim=simulator, max_primitives=max_primitives, seed=seed)
+        execution = plan.execute(sim=simulator, max_primitives=max_primitives, seed=seed,
+                                 on_primitive=watch.after_primitive)
     finally:
         watch.close()
-        simulator.on_chunk = simulator.after_primitive = None
+        simulator.on_chunk = None
     t_out = time.perf_counter()
     echo(str(execution))
     if plan.kind == "affordplan":
