@@ -464,29 +464,20 @@ def bench(repeats: int = 5, max_primitives: int = 30, sim: str = "arm", seed: in
     echo(f"the demo scene ({scene.name}), seed {seed}, {sim} sim, at most {max_primitives} primitives; "
          f"video {width}x{height}, a frame every {frame_interval:g} s, quality {quality}")
 
-    class Filmed(Simulator):  # a frame after every primitive, as the demo's strip takes them
-        recorder: FrameRecorder | None = None
-
-        def execute(self, contact, motion, normal=None):
-            try:
-                return super().execute(contact, motion, normal=normal)
-            finally:
-                if self.recorder is not None:
-                    self.recorder.take()
-
     def run(video: bool) -> tuple[float, float, int, int]:
         plan = ap.plan(obj, scene.goal, start=scene.start, obstacles=scene.obstacles, time_limit=time_limit,
                        seed=seed)
-        simulator = Filmed(obj, obstacles=scene.obstacles, pusher=sim, seed=seed,
-                           sensor=skills_sensor(plan.planner.predictor.skills))
+        simulator = Simulator(obj, obstacles=scene.obstacles, pusher=sim, seed=seed,
+                              sensor=skills_sensor(plan.planner.predictor.skills))
         simulator.set_object_pose(plan.start_pose)
         recorder = FrameRecorder(simulator, width, height, camera, frame_interval, quality=quality) if video else None
         if recorder is not None:
-            simulator.recorder = recorder
             simulator.on_chunk = recorder.on_chunk
             recorder.capture()
         t0 = time.perf_counter()
-        execution = plan.execute(sim=simulator, max_primitives=max_primitives, seed=seed)
+        # a frame after every primitive (a push of several strides is one), as the demo's strip takes them
+        execution = plan.execute(sim=simulator, max_primitives=max_primitives, seed=seed,
+                                 on_primitive=None if recorder is None else lambda entry: recorder.take())
         simulator.on_chunk = None
         frames = recorder.frames if recorder is not None else []  # waits for the frames still being drawn
         t_exec = time.perf_counter() - t0
