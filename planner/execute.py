@@ -193,6 +193,12 @@ def _record_frame(sim: Simulator, render, frames: list[np.ndarray]) -> None:
         frames.append(f)
 
 
+def _check_on_primitive(on_primitive) -> None:
+    """Refuse an ``on_primitive`` that is neither ``None`` nor callable, before anything is executed."""
+    if on_primitive is not None and not callable(on_primitive):
+        raise InputError(f"on_primitive must be callable or None, got {type(on_primitive).__name__}")
+
+
 def _logged(log: list[LogEntry], entry: LogEntry, on_primitive: Callable[[LogEntry], None] | None) -> None:
     """Append ``entry`` to ``log`` and tell ``on_primitive`` (when given) that its primitive is done."""
     log.append(entry)
@@ -238,6 +244,7 @@ def execute_plan(plan, sim="arm", max_primitives: int = 60, render=None, seed: i
     """
     spin_strokes = as_whole("spin_strokes", spin_strokes, 1, MAX_STROKES)
     sensors = check_sensors(sensors)
+    _check_on_primitive(on_primitive)
     planner, goal = memory if memory is not None else plan.planner.fork(), plan.goal
     skills = skills if skills is not None else planner.predictor.skills
     obj = planner.obj
@@ -321,6 +328,7 @@ def execute_greedy(obj: ObjectModel, goal: Goal, T_start: np.ndarray, predictor,
                    max_primitives: int = 60, render=None, seed: int = 0,
                    on_primitive: Callable[[LogEntry], None] | None = None) -> Execution:
     """The greedy baseline (see the module docstring); ``on_primitive`` as for :func:`execute_plan`."""
+    _check_on_primitive(on_primitive)
     sim = _simulator(sim, obj, obstacles, T_start, seed, skills_sensor(predictor.skills))
     log: list[LogEntry] = []
     frames: list[np.ndarray] = []

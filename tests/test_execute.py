@@ -268,6 +268,10 @@ def test_on_primitive_is_told_each_primitive_once_in_order_a_push_of_several_str
     told = []
     greedy = execute_greedy(cube, goal, T0, StubPredictor(skills), sim=sim, max_primitives=15, on_primitive=told.append)
     assert told and all(a is b for a, b in zip(told, greedy.log)) and len(told) == greedy.n_primitives
+    with pytest.raises(ap.errors.InputError, match="on_primitive must be callable"):
+        execute_plan(plan, sim=sim, on_primitive=3)
+    with pytest.raises(ap.errors.InputError, match="on_primitive must be callable"):
+        execute_greedy(cube, goal, T0, StubPredictor(skills), sim=sim, on_primitive="log")
 
 
 class HalfSpin(IdealSkill):
