@@ -10,11 +10,12 @@ import torch
 
 from affordplan.errors import WeightsError
 from primitives.networks import HybridActorCritic, widen_input
-from primitives.weights_file import SHIPPED_DIR, load
+from primitives.weights_file import load, policy_path
 
 
-def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActorCritic:
-    """The ``primitive``'s policy from a ``policy.pt`` / ``checkpoint.pt`` file, or the shipped weights.
+def load_policy(weights: str | os.PathLike | None, primitive: str, sensor: str | None = None) -> HybridActorCritic:
+    """The ``primitive``'s policy from a ``policy.pt`` / ``checkpoint.pt`` file, or the shipped weights (with
+    ``sensor``, the shipped policy for that sensor's clouds: :func:`primitives.weights_file.policy_path`).
 
     The returned module's ``sensor`` attribute names the clouds it was trained on (its file's metadata:
     ``"cameras"`` or ``"surface"``).
@@ -22,7 +23,7 @@ def load_policy(weights: str | os.PathLike | None, primitive: str) -> HybridActo
     Raises:
         WeightsError: missing, damaged or unsafe file, or one for another skill or kind of model.
     """
-    path = Path(weights) if weights else SHIPPED_DIR / f"{primitive}.pt"
+    path = Path(weights) if weights else policy_path(primitive, sensor)
     if path.is_file() and path.name.startswith("checkpoint"):
         payload, meta = load(path, kind="checkpoint", skill=primitive)
     else:

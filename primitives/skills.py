@@ -28,6 +28,11 @@ another sensor's clouds (``{name}_success.pt``, ``{name}_frames.json``, ``{name}
 policy, fitted together). A skill called on a simulator then rates and picks its options with the ratings of that
 simulator's sensor (:meth:`Skill.ratings`), and a planner predicting clouds of a sensor asks for that sensor's.
 
+**A policy per sensor**: a folder ``weights/{sensor}/`` may also hold a policy of its own (``{name}.pt``), chosen
+for that sensor's clouds, with its ratings beside it (``{name}_success.pt`` at least; any of ``{name}_frames.json``,
+``{name}_success_searched.pt``, all fitted to that policy). A skill called on a simulator of that sensor then acts,
+rates and picks with that policy and its ratings (:meth:`Skill.ratings`): one skill, the best policy for each sensor.
+
 **Searched success model**: rating a request through the frame search runs the policy once per free frame (12
 for a spin by an angle: ~22 ms on one core). Where one is shipped (``weights/{name}_success_searched.pt``,
 ``python -m primitives.success train NAME --frames shipped``), ``success_probability`` asks it instead: a success
@@ -54,7 +59,7 @@ from primitives.params import SKILLS, ParamsLike, SkillName, as_params
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
-from primitives.weights_file import rated_for, rating_name, rating_path
+from primitives.weights_file import policy_path, rated_for, rating_name, rating_path
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -65,7 +70,8 @@ class Skill:
 
     ``success_weights``, ``frame_search`` and ``searched_weights`` are the ratings for clouds of the sensor the
     policy was trained on (:attr:`sensor`); ``ratings_by_sensor`` maps another sensor's name to a :class:`Skill`
-    of the same policy whose ratings were fitted to that sensor's clouds (:meth:`ratings`).
+    of the same name that acts on that sensor's clouds: the same policy with ratings fitted to them, or a policy
+    chosen for them with its own ratings (:meth:`ratings`).
     """
 
     def __init__(self, name: SkillName, model: HybridActorCritic, n_points: int = 256,
@@ -84,12 +90,13 @@ class Skill:
         self._searched: SuccessModel | None = None
         self._by_sensor = dict(ratings_by_sensor or {})
         for sensor, other in self._by_sensor.items():
-            if other.model is not model or other.name != name:
-                raise InputError(f"the {sensor} ratings of {name} must be for the same policy")
+            if other.name != name or other._by_sensor:
+                raise InputError(f"the {sensor} skill of {name} must be a {name} skill without sensors of its own")
 
     def ratings(self, sensor: str | None) -> Skill:
-        """The skill whose ratings (success model, frame search, searched model) fit clouds of ``sensor``: this one,
-        or the one fitted to that sensor's clouds where there is one (same policy). ``None``: this one."""
+        """The skill that acts on and rates clouds of ``sensor``: this one, or the one given for that sensor where
+        there is one (the same policy with ratings fitted to those clouds, or a policy chosen for them with its own
+        ratings). ``None``: this one."""
         return self._by_sensor.get(sensor, self) if sensor is not None and sensor != self.sensor else self
 
     @property
@@ -130,7 +137,11 @@ class Skill:
         return seen.points[idx], seen.normals[idx], seen.motion_to_world(motion)
 
     def act(self, sim: Simulator, params: ParamsLike = None) -> tuple[np.ndarray, np.ndarray]:
-        """The contact point (world, metres) and world-frame motion in [-1, 1]^3 the policy picks."""
+        """The contact point (world, metres) and world-frame motion in [-1, 1]^3 the policy picks (the policy for
+        ``sim``'s sensor: :meth:`ratings`)."""
+        rated = self.ratings(getattr(sim, "sensor", None))
+        if rated is not self:
+            return rated.act(sim, params)
         contact, _, motion = self._decide(self.observe(sim, params))
         return contact, motion
 
@@ -143,7 +154,11 @@ class Skill:
         policy's next best contact is tried, up to ``MAX_REACH_RETRIES`` times; the last try is executed as
         it is (a blocked descent then fails without touching anything, an unreachable contact raises).
         Without this, a planner asking for the same push again meets the same contact every time.
+        The policy and ratings are those for ``sim``'s sensor (:meth:`ratings`).
         """
+        rated = self.ratings(getattr(sim, "sensor", None))
+        if rated is not self:
+            return rated.execute(sim, params)
         seen = self.observe(sim, params)
         allowed = np.ones(len(seen.points), dtype=bool)
         retries = 0
@@ -245,7 +260,8 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
     With the shipped files or a ``weights_dir``, a subfolder named after a sensor (``cameras/``) that holds any of
     ``{name}_success.pt``, ``{name}_frames.json``, ``{name}_success_searched.pt`` refitted to that sensor's clouds
     gives the skill ratings for them (:meth:`Skill.ratings`): those files, and the policy's own for the others
-    (:func:`primitives.weights_file.rating_path`).
+    (:func:`primitives.weights_file.rating_path`). A subfolder that holds ``{name}.pt`` gives the skill a policy for
+    that sensor's clouds, with the ratings in that folder alone (its ``{name}_success.pt`` is required).
     """
     if name not in SKILLS:
         raise InputError(f"unknown skill {name!r}; expected one of {SKILLS}")
@@ -276,8 +292,15 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
             own = policy.sensor  # known here: the rules below need not read it from the policy's file again
             if rated_for(name, sensor, directory, trained_on=own):  # the others: the policy's own (rating_path)
                 searched_path = rating_path(name, "searched", sensor, directory, trained_on=own)
+                success_path = rating_path(name, "success", sensor, directory, trained_on=own)
+                acting = policy
+                if (own_policy := policy_path(name, sensor, directory)).parent != directory:
+                    if not success_path.exists():
+                        raise InputError(f"{own_policy} has no success model beside it ({success_path.name}, "
+                                         "fitted to that policy)")
+                    acting = load_policy(own_policy, name)
                 by_sensor[sensor] = Skill(
-                    name, policy, success_weights=rating_path(name, "success", sensor, directory, trained_on=own),
+                    name, acting, success_weights=success_path,
                     frame_search=shipped_frame_search(name, directory, sensor, trained_on=own),
                     searched_weights=searched_path if searched and searched_path.exists() else None)
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,

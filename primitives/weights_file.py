@@ -54,6 +54,16 @@ def rating_name(skill: str, rating: str) -> str:
     return names[rating]
 
 
+def policy_path(skill: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None) -> Path:
+    """The policy that acts on ``sensor``'s clouds: ``{weights_dir}/{sensor}/{skill}.pt`` where that folder holds one
+    of its own (a policy chosen for that sensor, its ratings beside it), else ``{weights_dir}/{skill}.pt`` (whether or
+    not it exists). ``weights_dir``: by default the shipped weights."""
+    base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
+    if sensor is not None and (base / sensor / f"{skill}.pt").is_file():
+        return base / sensor / f"{skill}.pt"
+    return base / f"{skill}.pt"
+
+
 def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None,
                 *, trained_on: str | None = None) -> Path:
     """The file of ``skill``'s ``rating`` (:data:`RATINGS`) for ``sensor``'s clouds.
@@ -61,11 +71,15 @@ def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir:
     A policy's ratings beside it (``{weights_dir}/{skill}_success.pt``, ``_frames.json``, ``_success_searched.pt``)
     fit the sensor it was trained on. ``{weights_dir}/{sensor}/`` may hold any of them refitted to another sensor's
     clouds: that file where it exists and the policy was trained on another sensor, else the one beside the policy
-    (whether or not it exists). ``weights_dir``: by default the shipped weights. ``trained_on``: the policy's sensor
-    where the caller has it (a loaded policy's ``sensor``); otherwise it is read from the policy's file when needed.
+    (whether or not it exists). Where ``{weights_dir}/{sensor}/`` holds a policy of its own (:func:`policy_path`),
+    its ratings are the ones in that folder (whether or not they exist): the others were fitted to another policy.
+    ``weights_dir``: by default the shipped weights. ``trained_on``: the policy's sensor where the caller has it (a
+    loaded policy's ``sensor``); otherwise it is read from the policy's file when needed.
     """
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
     name = rating_name(skill, rating)
+    if sensor is not None and policy_path(skill, sensor, base).parent != base:
+        return base / sensor / name
     if sensor is not None and (base / sensor / name).exists():
         own = trained_on if trained_on is not None else policy_sensor(skill, base)
         if own != sensor:
@@ -75,9 +89,11 @@ def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir:
 
 def rated_for(skill: str, sensor: str, weights_dir: str | os.PathLike | None = None, *,
               trained_on: str | None = None) -> bool:
-    """Whether any of ``skill``'s ratings was refitted to ``sensor``'s clouds (:func:`rating_path`; ``trained_on``
-    as there)."""
+    """Whether any of ``skill``'s ratings was refitted to ``sensor``'s clouds, or a policy of its own chosen for them
+    (:func:`rating_path`; ``trained_on`` as there)."""
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
+    if policy_path(skill, sensor, base).parent != base:
+        return True
     if not any((base / sensor / rating_name(skill, rating)).exists() for rating in RATINGS):
         return False
     own = trained_on if trained_on is not None else policy_sensor(skill, base)

@@ -104,7 +104,7 @@ def _copy_skill_files(name: str, folder, files=("{}.pt", "{}_success.pt", "{}_fr
     for pattern in files:
         shutil.copyfile(skills_module.WEIGHTS_DIR / pattern.format(name), folder / pattern.format(name))
     for sensor in SENSORS:
-        for pattern in files[1:]:
+        for pattern in files:
             source = skills_module.WEIGHTS_DIR / sensor / pattern.format(name)
             if source.exists():
                 (folder / sensor).mkdir(exist_ok=True)
@@ -277,7 +277,60 @@ def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, 
     assert load_skill("push", frame_search=False).rated_sensors == ("surface",)  # given files: those alone
 
 
-def test_ratings_for_another_policy_are_refused():
+def test_a_sensor_skill_of_another_name_or_with_sensors_of_its_own_is_refused():
     push, spin = load_skill("push"), load_skill("spin")
-    with pytest.raises(InputError, match="same policy"):
-        skills_module.Skill("push", push.model, ratings_by_sensor={"cameras": skills_module.Skill("push", spin.model)})
+    with pytest.raises(InputError, match="must be a push skill"):
+        skills_module.Skill("push", push.model, ratings_by_sensor={"cameras": skills_module.Skill("spin", spin.model)})
+    inner = skills_module.Skill("push", push.model)
+    nested = skills_module.Skill("push", push.model, ratings_by_sensor={"cameras": inner})
+    with pytest.raises(InputError, match="without sensors of its own"):
+        skills_module.Skill("push", push.model, ratings_by_sensor={"cameras": nested})
+
+
+def _perturbed_policy(name: str, path: Path, seed: int = 0) -> None:
+    """The shipped policy of ``name`` with every weight nudged (a different policy of the same network), at ``path``."""
+    payload, meta = weights_file.load(skills_module.WEIGHTS_DIR / f"{name}.pt", kind="policy", skill=name)
+    generator = torch.Generator().manual_seed(seed)
+    state = {key: value + 0.05 * value.std().nan_to_num() * torch.randn(value.shape, generator=generator)
+             if value.is_floating_point() and value.numel() > 1 else value for key, value in payload["model"].items()}
+    weights_file.save(path, dict(payload, model=state), meta)
+
+
+def test_a_sensor_folder_with_a_policy_of_its_own_acts_and_rates_on_that_sensors_clouds_with_it(tmp_path, cube):
+    _copy_skill_files("push", tmp_path, files=("{}.pt", "{}_success.pt"))
+    shutil.rmtree(tmp_path / "cameras")
+    (tmp_path / "cameras").mkdir()
+    _perturbed_policy("push", tmp_path / "cameras" / "push.pt")
+    with pytest.raises(InputError, match="no success model beside it"):  # ratings fitted to another policy: refused
+        load_skill("push", weights_dir=tmp_path)
+    shutil.copyfile(skills_module.WEIGHTS_DIR / "cameras" / "push_success.pt", tmp_path / "cameras" / "push_success.pt")
+    push = load_skill("push", weights_dir=tmp_path)
+    cameras = push.ratings("cameras")
+    assert push.rated_sensors == ("surface", "cameras") and cameras.model is not push.model
+    assert cameras._success_weights == tmp_path / "cameras" / "push_success.pt"
+    assert cameras.frame_search is None and cameras._searched_weights is None  # its folder's alone: none
+    assert weights_file.policy_path("push", "cameras", tmp_path) == tmp_path / "cameras" / "push.pt"
+    assert weights_file.policy_path("push", "surface", tmp_path) == tmp_path / "push.pt"
+    assert weights_file.rating_path("push", "frames", "cameras", tmp_path) == tmp_path / "cameras" / "push_frames.json"
+    alone = skills_module.Skill("push", cameras.model, success_weights=tmp_path / "cameras" / "push_success.pt")
+    moved = []
+    for params in ({"direction": 0.7}, {"direction": -2.0}, None):
+        p, contact = _rated(push, cube, "cameras", params)  # a camera cloud: the folder's policy and its rating
+        p_alone, contact_alone = _rated(alone, cube, "cameras", params)
+        assert p == pytest.approx(p_alone) and np.allclose(contact, contact_alone)
+        p, contact = _rated(push, cube, "surface", params)  # a surface cloud: the policy beside the ratings
+        p_own, contact_own = _rated(_own_ratings_only(push), cube, "surface", params)
+        assert p == pytest.approx(p_own) and np.allclose(contact, contact_own)
+        moved.append(not np.allclose(_rated(alone, cube, "surface", params)[1], contact_own))
+    sim = ap.Simulator(cube, seed=3, sensor="cameras")
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    out = push.execute(sim, {"direction": 0.7})
+    sim_alone = ap.Simulator(cube, seed=3, sensor="cameras")
+    sim_alone.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+    out_alone = alone.execute(sim_alone, {"direction": 0.7})
+    np.testing.assert_allclose(out.pose_after, out_alone.pose_after)
+    obs = push.observe(sim, {"direction": 0.0}).obs[None]
+    np.testing.assert_allclose(push.success_probability_obs(obs, sensor="cameras"), alone.success_probability_obs(obs))
+    assert any(moved)  # the folder's policy is another policy: it picks another contact on some of these clouds
+
+

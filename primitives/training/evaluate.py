@@ -399,7 +399,7 @@ def main(argv: list[str] | None = None) -> int:
     torch.set_num_threads(1)
     if args.strokes != 1:
         return _main_strokes(args, parser)
-    model = load_policy(args.weights, args.primitive)
+    model = load_policy(args.weights, args.primitive, sensor=args.sensor)
     search = _frame_search(args, parser)
     result = evaluate(model, args.primitive, _objects(args), args.trials, args.seed, progress=not args.json,
                       p_params=1.0 if args.params == "random" else 0.0, frame_search=search,

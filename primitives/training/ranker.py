@@ -89,7 +89,7 @@ def collect(skill: str, out: str | Path, starts: int, params: str = "none", obje
     check_objects(objects, fitting=True)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    policy = load_policy(None, skill)
+    policy = load_policy(None, skill, sensor)
     model = SuccessModel(policy, load_success_net(skill, None, sensor))
     search = load_frame_search(skill, "shipped", sensor)
     config = EnvConfig(skill, objects=objects, episodes_per_object=1, p_params=1.0 if params == "random" else 0.0,

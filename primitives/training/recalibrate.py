@@ -133,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
     if cache.exists():  # a run killed after collecting resumes here
         data = Rollouts.load(cache)
     else:
-        rater = SuccessModel(load_policy(args.policy, args.skill),
+        rater = SuccessModel(load_policy(args.policy, args.skill, sensor=args.sensor),
                              load_success_net(args.skill, None, sensor=args.sensor))
         search = load_frame_search(args.skill, args.frames, sensor=args.sensor)
         _, data = collect_frame_search(rater, args.skill, args.rollouts, search, args.objects, n_objects=200,

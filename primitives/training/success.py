@@ -721,7 +721,7 @@ def _run(args: argparse.Namespace) -> int:
         contrast = FrameSearch(CONTRAST_TURNS, mirror=True, stand_ins=args.contrast_stand_ins)
     out = Path(args.out or f"runs/{args.skill}_success")
     out.mkdir(parents=True, exist_ok=True)
-    policy = load_policy(args.policy, args.skill)
+    policy = load_policy(args.policy, args.skill, sensor=args.sensor)
     if args.command == "train":
         searched = args.frames is not None
         search = load_frame_search(args.skill, args.frames, sensor=args.sensor) if searched else None
