@@ -174,12 +174,12 @@ def test_camera_ratings_ship_into_the_sensor_folder_and_only_what_they_replace_i
     assert skill.ratings("cameras").frame_search.info["platt_note"] == "refit"
 
 
-@pytest.mark.parametrize("case", ["holds a policy", "the policy's own sensor", "no rating", "another policy",
+@pytest.mark.parametrize("case", ["a policy without its success model", "the policy's own sensor", "no rating", "another policy",
                                   "unknown sensor"])
 def test_camera_ratings_that_cannot_ship_are_refused_before_anything_moves(camera_layout, case):
     weights, cand, base = camera_layout
     sensor = "cameras"
-    if case == "holds a policy":
+    if case == "a policy without its success model":
         shutil.copy2(weights / "push.pt", cand / "push.pt")
     elif case == "the policy's own sensor":
         sensor = "surface"
@@ -194,3 +194,24 @@ def test_camera_ratings_that_cannot_ship_are_refused_before_anything_moves(camer
         plan_ship("push", cand, "push_cam_old", weights_dir=weights, base=base, sensor=sensor)
     assert {p.relative_to(weights): digest(p) for p in weights.rglob("*") if p.is_file()} == before
     assert not (base / "candidates").exists()
+
+
+def test_a_policy_for_a_sensor_ships_into_its_folder_keeping_every_file_of_the_skill_there(camera_layout):
+    weights, cand, base = camera_layout
+    for name in CORE:  # the 0.16 push with its own ratings, as the policy for camera clouds
+        shutil.copy2(CANDIDATES / "push_0.16" / name, cand / name)
+    beside = {p.name: digest(p) for p in weights.iterdir() if p.is_file()}
+    before = {p.name: digest(p) for p in (weights / "cameras").iterdir()}
+    plan = plan_ship("push", cand, "push_cam_old", weights_dir=weights, base=base, sensor="cameras")
+    assert plan.target == weights / "cameras" and {p.name for p in plan.to_keep} == set(before)
+    ship(plan, "9.9.9")
+    assert {p.name: digest(p) for p in (base / "candidates" / "push_cam_old").iterdir()} == before
+    assert {p.name for p in (weights / "cameras").iterdir()} == set(CORE)
+    assert digest(weights / "cameras" / "push.pt") == digest(cand / "push.pt")  # the policy itself is never touched
+    assert {p.name: digest(p) for p in weights.iterdir() if p.is_file()} == beside
+    skill = load_skill("push", weights_dir=weights)
+    cameras = skill.ratings("cameras")
+    assert skill.rated_sensors == ("surface", "cameras") and cameras.model is not skill.model
+    assert cameras._success_weights == weights / "cameras" / "push_success.pt"
+    assert torch.equal(cameras.model.state_dict()["actor.0.weight"],
+                       load_skill("push", weights_dir=CANDIDATES / "push_0.16").model.state_dict()["actor.0.weight"])

@@ -32,6 +32,13 @@ ratings serve it). Their ``policy`` must be the shipped one, and a ``model`` or 
 or the one that serves the sensor now. Only the files the set replaces are kept; the subfolder's others stay.
 
     python -m primitives.research.ship roll --sensor cameras --from candidates/roll_cam --keep roll_cam_0.24
+
+**A policy for another sensor** (``--sensor cameras`` with a set that holds a policy): a policy chosen for that
+sensor's clouds with its own ratings (:func:`primitives.weights_file.policy_path`), checked as a set without
+``--sensor`` is; it ships into ``weights/{sensor}/``, and every file of the skill there is kept first (ratings
+fitted to another policy must not stay beside it). To give a sensor the policy shipped now, while another takes
+its place for the other sensors: ship a set of that policy with its ratings for the sensor (``--sensor``), then the
+new policy with its own (without).
 """
 
 from __future__ import annotations
@@ -146,7 +153,8 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
     if keep_dir.exists():
         raise InputError(f"{keep_dir} exists already; choose another --keep name")
     names = role_files(skill)
-    if sensor is None:
+    with_policy = sensor is not None and (source / names["policy"]).exists()  # a policy for that sensor's clouds
+    if sensor is None or with_policy:
         for role in ("policy", "model"):
             if not (source / names[role]).exists():
                 raise InputError(f"the candidate set has no {names[role]} (its {role})")
@@ -155,7 +163,8 @@ def plan_ship(skill: str, source: str | Path, keep: str, weights_dir: str | Path
         except AffordplanError as exc:
             raise InputError(f"the candidate set does not load as the {skill} skill: {exc}") from exc
         serving = {role: source / names[role] for role in ROLES if (source / names[role]).exists()}
-        to_keep = skill_files(weights_dir, skill)
+        target = weights_dir if sensor is None else weights_dir / sensor
+        to_keep = skill_files(target, skill) if target.is_dir() else []
     else:
         serving = _ratings_serving(skill, source, weights_dir, sensor)
         to_keep = [p for p in skill_files(weights_dir / sensor, skill) if (source / p.name).exists()] \
@@ -295,8 +304,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--release", default=None, help="the release the note names (default: the package version)")
     parser.add_argument("--weights-dir", default=None, help="the weights folder to ship into (default: the package's)")
     parser.add_argument("--sensor", choices=SENSORS, default=None,
-                        help="the set holds ratings of the shipped policy refitted to this sensor's clouds: ship them "
-                             "into weights/SENSOR/ (default: the set is a policy with its own ratings)")
+                        help="ship into weights/SENSOR/: the set holds ratings of the shipped policy refitted to this "
+                             "sensor's clouds, or a policy for them with its own ratings (default: the set is the "
+                             "policy for every other sensor, with its own ratings)")
     parser.add_argument("--dry-run", action="store_true", help="check and print what would move; change nothing")
     args = parser.parse_args(argv)
     cli_logging()
