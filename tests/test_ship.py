@@ -174,8 +174,8 @@ def test_camera_ratings_ship_into_the_sensor_folder_and_only_what_they_replace_i
     assert skill.ratings("cameras").frame_search.info["platt_note"] == "refit"
 
 
-@pytest.mark.parametrize("case", ["a policy without its success model", "the policy's own sensor", "no rating", "another policy",
-                                  "unknown sensor"])
+@pytest.mark.parametrize("case", ["a policy without its success model", "the policy's own sensor", "no rating",
+                                  "another policy", "unknown sensor"])
 def test_camera_ratings_that_cannot_ship_are_refused_before_anything_moves(camera_layout, case):
     weights, cand, base = camera_layout
     sensor = "cameras"
