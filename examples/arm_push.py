@@ -10,6 +10,7 @@ prints the outcome and the fingertip tracking error, and writes three frames sid
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 from PIL import Image
@@ -22,6 +23,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", default="arm_push.png")
     args = parser.parse_args()
+    if Path(args.out).suffix.lower() not in (".png", ".jpg", ".jpeg"):  # checked before the minute of physics
+        parser.error(f"--out must name a .png or .jpg picture, got {args.out!r}")
 
     mug = ap.load_object("mug")
     wall = ap.Box(center=(0.58, 0.09), size=(0.3, 0.02, 0.06))

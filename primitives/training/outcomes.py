@@ -55,7 +55,10 @@ for each rollout's ``p`` (target 0.8), the mean predicted against measured progr
 - ``spin_outcome.npz``: 600 rows on 329 objects (283 household rows), 0 skipped, 1 invalid; 157 s (2 min 43 s),
   24.0 kB. Strict success 0.613, mean p 0.827, made progress 0.865, mean progress 0.906.
 - ``roll_outcome.npz``: 600 rows on 294 objects (290 household rows), 203 starts skipped (no state one roll away),
-  5 invalid; 179 s (3 min 7 s), 18.8 kB. Strict success 0.497, mean p 0.585, made progress 0.502.
+  5 invalid; 179 s (3 min 7 s), 18.8 kB. Strict success 0.497, mean p 0.585, made progress 0.502. Recollected
+  (2026-12-03, the same command, alone on the machine) for roll's refitted surface policy (``weights/RECORD.md``):
+  600 rows on 294 objects, 203 skipped; 116 s. Strict success 0.543, mean p 0.521, made progress 0.558; it records
+  the drop probabilities itself, so it needed no annotating.
 
 The three files were then annotated (``annotate primitives/weights/{push,spin,roll}_outcome.npz``, 77 s for the
 three, every other column unchanged): 4.2 % of the pushes and 2.2 % of the spins left their resting state; pushes
@@ -76,7 +79,13 @@ Checked on objects never collected on (the shipped models, 150 rollouts per skil
     roll  housekeep:unseen  0.907 (0.067, 0.027)             0.359 / 0.373         0.230 (0.243), accuracy 0.693
     roll  test              0.980 (0.000, 0.020)             0.654 / 0.780         0.116 (0.099), accuracy 0.827
 
-(wall 21-55 s per check; roll skipped 47 and 37 starts.) The intervals are too narrow on the unseen household meshes
+(wall 21-55 s per check; roll skipped 47 and 37 starts.) Roll's recollected file (its refitted surface policy), the
+same checks on 2026-12-03:
+
+    roll  housekeep:unseen  0.953 (0.013, 0.033)             0.496 / 0.593         0.198 (0.220), accuracy 0.733
+    roll  test              0.980 (0.013, 0.007)             0.740 / 0.727         0.086 (0.115), accuracy 0.880
+
+The intervals are too narrow on the unseen household meshes
 (their outcomes spread wider than the training mix's at the same p) and about right on procedural objects; a roll's
 progress is 0 or 1, so its interval covers trivially and ``p_progress``'s Brier score is the measure. "strict p":
 the success model's p against the strict success, for comparison.
