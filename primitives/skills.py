@@ -97,7 +97,7 @@ class Skill:
         """The skill that acts on and rates clouds of ``sensor``: this one, or the one given for that sensor where
         there is one (the same policy with ratings fitted to those clouds, or a policy chosen for them with its own
         ratings). ``None``: this one."""
-        return self._by_sensor.get(sensor, self) if sensor is not None and sensor != self.sensor else self
+        return self._by_sensor.get(sensor, self) if sensor is not None else self
 
     @property
     def rated_sensors(self) -> tuple[str, ...]:
@@ -275,8 +275,7 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
             raise InputError(f"weights_dir {str(folder)!r} is not a folder")
         if (folder / f"{name}.pt").exists():  # the folder's files, used together as the shipped ones are
             weights, success_weights = folder / f"{name}.pt", folder / f"{name}_success.pt"
-            if not success_weights.exists():
-                raise InputError(f"{weights} has no success model beside it ({name}_success.pt, fitted to that policy)")
+            _require_success_beside(weights, success_weights)
             directory = folder
     torch.set_num_threads(max(1, min(torch.get_num_threads(), 2)))
     if frame_search is True:
@@ -295,9 +294,7 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
                 success_path = rating_path(name, "success", sensor, directory, trained_on=own)
                 acting = policy
                 if (own_policy := policy_path(name, sensor, directory)).parent != directory:
-                    if not success_path.exists():
-                        raise InputError(f"{own_policy} has no success model beside it ({success_path.name}, "
-                                         "fitted to that policy)")
+                    _require_success_beside(own_policy, success_path)
                     acting = load_policy(own_policy, name)
                 by_sensor[sensor] = Skill(
                     name, acting, success_weights=success_path,
@@ -306,6 +303,12 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
                  searched_weights=_searched_beside(name, directory, searched and shipped),
                  ratings_by_sensor=by_sensor)
+
+
+def _require_success_beside(policy: Path, success: Path) -> None:
+    """Refuse a policy file whose success model (fitted to it, in the same folder) is missing."""
+    if not success.exists():
+        raise InputError(f"{policy} has no success model beside it ({success.name}, fitted to that policy)")
 
 
 def _searched_beside(name: SkillName, folder: Path, wanted: bool) -> Path | None:

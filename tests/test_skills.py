@@ -334,3 +334,16 @@ def test_a_sensor_folder_with_a_policy_of_its_own_acts_and_rates_on_that_sensors
     assert any(moved)  # the folder's policy is another policy: it picks another contact on some of these clouds
 
 
+def test_a_sensor_folder_policy_serves_that_sensor_even_where_the_main_policy_was_trained_on_it(tmp_path, cube):
+    _copy_skill_files("push", tmp_path, files=("{}.pt", "{}_success.pt"))
+    shutil.rmtree(tmp_path / "cameras")
+    (tmp_path / "surface").mkdir()  # the main push.pt was trained on the surface sample
+    _perturbed_policy("push", tmp_path / "surface" / "push.pt")
+    shutil.copyfile(skills_module.WEIGHTS_DIR / "push_success.pt", tmp_path / "surface" / "push_success.pt")
+    push = load_skill("push", weights_dir=tmp_path)
+    assert push.sensor == "surface" and push.ratings("surface").model is not push.model
+    alone = skills_module.Skill("push", push.ratings("surface").model,
+                                success_weights=tmp_path / "surface" / "push_success.pt")
+    p, contact = _rated(push, cube, "surface", {"direction": 0.7})
+    p_alone, contact_alone = _rated(alone, cube, "surface", {"direction": 0.7})
+    assert p == pytest.approx(p_alone) and np.allclose(contact, contact_alone)
