@@ -44,7 +44,7 @@ MODULES: list[tuple[str, list[str]]] = [
     ("Planning internals", ["planner.graph", "planner.footprint", "planner.motion", "planner.chain",
                             "planner.predict", "planner.places", "planner.ratings", "planner.memory",
                             "planner.odds"]),
-    ("Benchmarks", ["affordplan.app.bench.primitive", "affordplan.app.bench.plan"]),
+    ("Benchmarks", ["affordplan.app.bench.primitive", "affordplan.app.bench.plan", "affordplan.app.bench.compare"]),
 ]
 
 

@@ -184,6 +184,14 @@ def _cmd_bench_pool(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench_compare(args: argparse.Namespace) -> int:
+    from affordplan.app.bench.compare import compare
+
+    comparison = compare(_read_runs(args.base), _read_runs(args.candidate))
+    print(json.dumps(comparison.summary(), indent=2) if args.json else comparison.report())
+    return 0
+
+
 def _cmd_bench_fit_stuck(args: argparse.Namespace) -> int:
     from affordplan.app.bench.plan import fit_stuck
 
@@ -586,6 +594,18 @@ def build_parser() -> argparse.ArgumentParser:
                      help="also draw primitives per task and the plan-level calibration to this image")
     bpo.add_argument("--json", action="store_true", help="print JSON instead of text")
     bpo.set_defaults(func=_cmd_bench_pool)
+    bco = bench_sub.add_parser(
+        "compare", help="two sets of saved `bench plan --json` runs of the same tasks, task by task",
+        formatter_class=_formatter,
+        description=_wrap("Pair the tasks of a base and a candidate set of saved plan-bench runs (the same seeds "
+                          "draw the same tasks) and report success of each, the tasks gained and lost with an exact "
+                          "sign test on them, and primitives and strokes per task over the tasks both reached."),
+        epilog="example:\n  affordplan bench compare --base runs/before_s*.json --candidate runs/after_s*.json")
+    bco.add_argument("--base", nargs="+", required=True, metavar="JSON", help="bench plan --json outputs: the base")
+    bco.add_argument("--candidate", nargs="+", required=True, metavar="JSON",
+                     help="bench plan --json outputs of the same tasks: the candidate")
+    bco.add_argument("--json", action="store_true", help="print JSON instead of text")
+    bco.set_defaults(func=_cmd_bench_compare)
     _register_robustness(bench_sub)
     return parser
 
