@@ -9,7 +9,9 @@ messages reach the user as plain lines on stderr, while the program's results (t
 from __future__ import annotations
 
 import functools
+import io
 import logging
+import os
 import sys
 from collections.abc import Callable
 
@@ -45,11 +47,22 @@ def cli_logging(verbose: bool = False) -> None:
         logging.getLogger(name).setLevel(level)
 
 
+def _silence_stdout() -> None:
+    """Point stdout's file descriptor at the null device, so that the interpreter's flush at exit does not fail on the
+    pipe its reader closed (the recipe of Python's documentation on SIGPIPE)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError, io.UnsupportedOperation):  # stdout replaced (tests), or closed
+        pass
+
+
 def one_line_errors(prog: str, *errors: type[BaseException]) -> Callable[[Main], Main]:
     """Decorate a command line's ``main(argv) -> int``: an :class:`~affordplan.errors.AffordplanError`, or one of
     ``errors``, raised in it is printed as one line, ``{prog}: error: {message}``, on stderr, and ``main`` returns 2,
-    argparse's status for a refused command line. Anything else propagates with its traceback (a bug is not bad
-    input)."""
+    argparse's status for a refused command line. Output cut off by its reader (``affordplan ... | head``) ends ``main``
+    quietly with status 1, as a closed pipe ends other tools. Anything else propagates with its traceback (a bug is
+    not bad input)."""
     caught = (AffordplanError, *errors)
 
     def decorate(main: Main) -> Main:
@@ -57,6 +70,9 @@ def one_line_errors(prog: str, *errors: type[BaseException]) -> Callable[[Main],
         def run(argv: list[str] | None = None) -> int:
             try:
                 return main(argv)
+            except BrokenPipeError:  # before OSError, which some commands catch as bad input
+                _silence_stdout()
+                return 1
             except caught as exc:
                 print(f"{prog}: error: {exc}", file=sys.stderr)
                 return 2

@@ -98,3 +98,14 @@ def test_a_command_lines_bad_input_is_one_line_and_status_2_and_a_bug_is_a_trace
     assert main(["missing"]) == 2 and capsys.readouterr().err == "prog: error: no file runs/x.npz\n"
     with pytest.raises(KeyError):
         main(["bug"])
+
+
+def test_output_cut_off_by_its_reader_ends_a_command_line_quietly_with_status_1(capsys):
+    """``affordplan bench compare ... | head -2`` closed the pipe: no traceback, no 'error:' line (a broken pipe is an
+    OSError, which a command may catch as bad input)."""
+    @one_line_errors("prog", OSError)
+    def main(argv=None):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    assert main([]) == 1
+    assert capsys.readouterr().err == ""
