@@ -59,7 +59,7 @@ from primitives.params import SKILLS, ParamsLike, SkillName, as_params
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
-from primitives.weights_file import policy_path, rated_for, rating_name, rating_path
+from primitives.weights_file import rated_for, rating_name, rating_path, sensor_policy
 
 MAX_REACH_RETRIES = 8  # next-best contacts tried after the arm could not reach the policy's choice
 UNREACHABLE_RADIUS = 0.02  # metres: points this close to an unreachable contact are masked out with it
@@ -293,7 +293,7 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
                 searched_path = rating_path(name, "searched", sensor, directory, trained_on=own)
                 success_path = rating_path(name, "success", sensor, directory, trained_on=own)
                 acting = policy
-                if (own_policy := policy_path(name, sensor, directory)).parent != directory:
+                if (own_policy := sensor_policy(name, sensor, directory)) is not None:
                     _require_success_beside(own_policy, success_path)
                     acting = load_policy(own_policy, name)
                 by_sensor[sensor] = Skill(

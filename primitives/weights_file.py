@@ -54,14 +54,21 @@ def rating_name(skill: str, rating: str) -> str:
     return names[rating]
 
 
-def policy_path(skill: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None) -> Path:
-    """The policy that acts on ``sensor``'s clouds: ``{weights_dir}/{sensor}/{skill}.pt`` where that folder holds one
-    of its own (a policy chosen for that sensor, its ratings beside it), else ``{weights_dir}/{skill}.pt`` (whether or
-    not it exists). ``weights_dir``: by default the shipped weights."""
+def sensor_policy(skill: str, sensor: str | None, weights_dir: str | os.PathLike | None = None) -> Path | None:
+    """``{weights_dir}/{sensor}/{skill}.pt`` where that folder holds a policy of its own (one chosen for ``sensor``'s
+    clouds, its ratings beside it), else ``None`` (also for ``sensor=None``). ``weights_dir``: by default the
+    shipped weights."""
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
-    if sensor is not None and (base / sensor / f"{skill}.pt").is_file():
-        return base / sensor / f"{skill}.pt"
-    return base / f"{skill}.pt"
+    if sensor is not None and (path := base / sensor / f"{skill}.pt").is_file():
+        return path
+    return None
+
+
+def policy_path(skill: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None) -> Path:
+    """The policy that acts on ``sensor``'s clouds: :func:`sensor_policy` where there is one, else
+    ``{weights_dir}/{skill}.pt`` (whether or not it exists). ``weights_dir``: by default the shipped weights."""
+    base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
+    return sensor_policy(skill, sensor, base) or base / f"{skill}.pt"
 
 
 def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir: str | os.PathLike | None = None,
@@ -78,7 +85,7 @@ def rating_path(skill: str, rating: str, sensor: str | None = None, weights_dir:
     """
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
     name = rating_name(skill, rating)
-    if sensor is not None and policy_path(skill, sensor, base).parent != base:
+    if sensor_policy(skill, sensor, base) is not None:
         return base / sensor / name
     if sensor is not None and (base / sensor / name).exists():
         own = trained_on if trained_on is not None else policy_sensor(skill, base)
@@ -92,7 +99,7 @@ def rated_for(skill: str, sensor: str, weights_dir: str | os.PathLike | None = N
     """Whether any of ``skill``'s ratings was refitted to ``sensor``'s clouds, or a policy of its own chosen for them
     (:func:`rating_path`; ``trained_on`` as there)."""
     base = Path(weights_dir) if weights_dir is not None else SHIPPED_DIR
-    if policy_path(skill, sensor, base).parent != base:
+    if sensor_policy(skill, sensor, base) is not None:
         return True
     if not any((base / sensor / rating_name(skill, rating)).exists() for rating in RATINGS):
         return False

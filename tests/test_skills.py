@@ -311,6 +311,9 @@ def test_a_sensor_folder_with_a_policy_of_its_own_acts_and_rates_on_that_sensors
     assert cameras.frame_search is None and cameras._searched_weights is None  # its folder's alone: none
     assert weights_file.policy_path("push", "cameras", tmp_path) == tmp_path / "cameras" / "push.pt"
     assert weights_file.policy_path("push", "surface", tmp_path) == tmp_path / "push.pt"
+    assert weights_file.sensor_policy("push", "cameras", tmp_path) == tmp_path / "cameras" / "push.pt"
+    assert weights_file.sensor_policy("push", "surface", tmp_path) is None
+    assert weights_file.sensor_policy("push", None, tmp_path) is None
     assert weights_file.rating_path("push", "frames", "cameras", tmp_path) == tmp_path / "cameras" / "push_frames.json"
     alone = skills_module.Skill("push", cameras.model, success_weights=tmp_path / "cameras" / "push_success.pt")
     moved = []
