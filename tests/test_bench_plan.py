@@ -94,6 +94,16 @@ def test_bench_reports_goals_in_rare_resting_states_apart_and_counts_them_in():
     assert "rare goal 1/2" in report.report() and "by what they missed: state 1, yaw 1" in report.report()
 
 
+def test_the_report_prints_a_dash_for_a_longest_plan_it_has_no_figure_for():
+    from affordplan.app.bench.plan import BenchReport, TaskResult
+
+    timed = TaskResult("affordplan", "open", True, 0.1, 5, 1, "", 0.4, max_planning_time=0.25)
+    greedy = TaskResult("greedy", "open", True, 0.2, 9, 0, "", 0.4)  # greedy makes no plan: no longest one
+    rows = {line.split()[0]: line for line in BenchReport([timed, greedy]).report().splitlines()[2:4]}
+    assert "100 /    250 ms" in rows["affordplan"] and "200 /      - ms" in rows["greedy"]
+    assert "nan" not in rows["greedy"]
+
+
 def test_household_tasks_take_the_unseen_meshes_validation_tasks_the_validation_ones_and_mixed_alternate():
     from affordplan.app.bench.plan import task_object
     from affordplan.objects import housekeep

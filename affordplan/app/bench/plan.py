@@ -132,7 +132,7 @@ class BenchReport:
             rare = s["rare_goal_states"]
             rare_text = f"{rare['reached']}/{rare['tasks']}" if rare["tasks"] else "none"
             lines.append(f"{s['planner']:10s} {s['tasks']:5d} {s['success']:8.2f} "
-                         f"{1e3 * s['median_planning_time_s']:10.0f} / {1e3 * s['max_planning_time_s']:6.0f} ms "
+                         f"{1e3 * s['median_planning_time_s']:10.0f} / {_ms(s['max_planning_time_s']):>6s} ms "
                          f"{s['mean_primitives']:17.1f} / {s['median_primitives']:4.0f} / {s['p90_primitives']:4.0f} "
                          f"{s['mean_replans']:13.1f}  {scenes}; rare goal {rare_text}; fingertip strokes (mean / "
                          f"median) {s['mean_strokes']:.1f} / {s['median_strokes']:.0f}")
@@ -275,6 +275,11 @@ def run_task(task: Task, obj: ObjectModel, planner_name: str, sim: str, predicto
                       expected_primitives=predicted[1], max_planning_time=float(longest), object_name=obj.name,
                       steps=p.planner.odds_steps(p.steps) if planner_name == "affordplan" else [],
                       strokes=ex.strokes)
+
+
+def _ms(seconds: float) -> str:
+    """``seconds`` in whole milliseconds, or ``-`` where there is no figure (greedy's longest plan: it makes none)."""
+    return f"{1e3 * seconds:.0f}" if np.isfinite(seconds) else "-"
 
 
 def _describe(task: Task) -> str:
