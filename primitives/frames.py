@@ -149,7 +149,10 @@ class FrameSearch:
     score with ``platt_stand_ins`` instead of ``platt_unparameterised``. ``info``: how the calibration was made
     (command, figures). ``ranker``: an :class:`~primitives.option_ranker.OptionRanker` that picks the option to
     act in for the seed's objective instead of the ratings (:meth:`ranks`, :meth:`choose`), loaded from the file
-    ``ranker_file`` names beside the JSON file (:meth:`load`); ``None``: the ratings pick.
+    ``ranker_file`` names beside the JSON file (:meth:`load`); ``None``: the ratings pick. ``reports_rating``: the
+    skill reports this search's own calibrated rating of the option it picks as its success probability, and
+    no searched success model (:func:`primitives.skills.load_skill`), where that was chosen on validation objects
+    (push's search for camera clouds: ``primitives/weights/RECORD.md``); ``False``: a searched model where one ships.
     """
 
     turns: int = 1
@@ -159,6 +162,7 @@ class FrameSearch:
     info: dict = field(default_factory=dict, compare=False)
     stand_ins: int = 0
     platt_stand_ins: tuple[float, float] = (1.0, 0.0)
+    reports_rating: bool = False
     ranker_file: str = ""
     ranker: OptionRanker | None = field(default=None, compare=False, repr=False)
 
@@ -313,6 +317,8 @@ class FrameSearch:
         for key in ("platt", "platt_unparameterised", "platt_stand_ins"):
             d[key] = list(d[key])
         del d["ranker"], d["ranker_file"]
+        if not self.reports_rating:  # written only where set, as files before it had no such key
+            del d["reports_rating"]
         if self.ranker_file:
             d["ranker"] = self.ranker_file
         Path(path).write_text(json.dumps(d, indent=2) + "\n")
@@ -326,7 +332,8 @@ class FrameSearch:
             ranker_file = str(d.get("ranker", ""))
             search = cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
                          tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}),
-                         int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))))
+                         int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))),
+                         reports_rating=_flag(d.get("reports_rating", False)))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
         if not ranker_file or not ranked:
@@ -335,6 +342,13 @@ class FrameSearch:
             raise InputError(f"frame search file {path} names its ranker {ranker_file!r}; it must be a file name "
                              f"beside it")
         return replace(search, ranker_file=ranker_file, ranker=load_ranker(Path(path).parent / ranker_file))
+
+
+def _flag(value: object) -> bool:
+    """A JSON true or false (raises ``TypeError`` for anything else, which :meth:`FrameSearch.load` reports)."""
+    if not isinstance(value, bool):
+        raise TypeError(f"expected true or false, got {value!r}")
+    return value
 
 
 def shipped_frame_search(name: str, weights_dir: str | os.PathLike | None = None,

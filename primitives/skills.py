@@ -296,13 +296,21 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
                 if (own_policy := sensor_policy(name, sensor, directory)) is not None:
                     _require_success_beside(own_policy, success_path)
                     acting = load_policy(own_policy, name)
+                search = shipped_frame_search(name, directory, sensor, trained_on=own)
                 by_sensor[sensor] = Skill(
-                    name, acting, success_weights=success_path,
-                    frame_search=shipped_frame_search(name, directory, sensor, trained_on=own),
-                    searched_weights=searched_path if searched and searched_path.exists() else None)
+                    name, acting, success_weights=success_path, frame_search=search,
+                    searched_weights=searched_path if searched and searched_path.exists()
+                    and not _reports_rating(search) else None)
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
-                 searched_weights=_searched_beside(name, directory, searched and shipped),
+                 searched_weights=_searched_beside(name, directory, searched and shipped
+                                                   and not _reports_rating(frame_search)),
                  ratings_by_sensor=by_sensor)
+
+
+def _reports_rating(search: FrameSearch | None) -> bool:
+    """Whether the skill acting with ``search`` reports that search's own calibrated rating rather than a searched
+    success model (:attr:`primitives.frames.FrameSearch.reports_rating`)."""
+    return search is not None and search.reports_rating
 
 
 def _require_success_beside(policy: Path, success: Path) -> None:

@@ -1,6 +1,8 @@
 """Frame search: the free goal frames of each request, re-framing observations, the skill acting in the best."""
 
+import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -153,6 +155,21 @@ def test_frame_search_calibration_and_files(tmp_path):
         FrameSearch(12, True, (float("nan"), 0.0))
     with pytest.raises(InputError):
         FrameSearch(12, True, (1.0, 0.0), (1.0,))
+
+
+def test_a_search_that_reports_its_own_rating_says_so_in_its_file_and_only_there(tmp_path):
+    plain = FrameSearch(12, True, (0.8, -0.3))
+    assert not plain.reports_rating
+    plain.save(tmp_path / "plain.json")
+    assert "reports_rating" not in json.loads((tmp_path / "plain.json").read_text())  # files before it: unchanged
+    reporting = replace(plain, reports_rating=True)
+    reporting.save(tmp_path / "reporting.json")
+    back = FrameSearch.load(tmp_path / "reporting.json")
+    assert back.reports_rating and back == reporting and back != plain
+    d = json.loads((tmp_path / "reporting.json").read_text())
+    (tmp_path / "bad.json").write_text(json.dumps(dict(d, reports_rating="yes")))
+    with pytest.raises(InputError, match="unreadable.*true or false"):
+        FrameSearch.load(tmp_path / "bad.json")
 
 
 def test_a_skill_with_frame_search_acts_in_its_likeliest_frame():

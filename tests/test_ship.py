@@ -142,7 +142,7 @@ def camera_layout(tmp_path):
     cand.mkdir()
     for name in CORE:
         shutil.copy2(WEIGHTS_DIR / name, weights / name)
-    for name in ("push_success.pt", "push_frames.json", "push_success_searched.pt"):
+    for name in ("push_success.pt", "push_frames.json"):  # what ships for camera clouds (no searched model)
         shutil.copy2(WEIGHTS_DIR / "cameras" / name, weights / "cameras" / name)
     shutil.copy2(WEIGHTS_DIR / "cameras" / "push_frames.json", cand / "push_frames.json")
     (base / "runs" / "p").mkdir(parents=True)

@@ -15,7 +15,10 @@ from affordplan.errors import InputError, ReachabilityError
 from affordplan.sim.sensor import SENSORS
 from primitives import load_skill, rewards, weights_file
 from primitives import skills as skills_module
+from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
+from primitives.params import as_params
+from primitives.training.env import skill_observation
 
 
 class _ReachLimited(ap.Simulator):
@@ -259,8 +262,7 @@ def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, 
     # one rating refitted: the camera ratings take it, and the policy's own files for the others
     for own in ("push_frames.json", "push_success_searched.pt"):
         shutil.copyfile(skills_module.WEIGHTS_DIR / own, tmp_path / own)
-    shutil.copyfile(skills_module.WEIGHTS_DIR / "cameras" / "push_success_searched.pt",
-                    tmp_path / "cameras" / "push_success_searched.pt")
+    _perturbed_policy("push", tmp_path / "cameras" / "push_success_searched.pt", kind="success")
     push = load_skill("push", weights_dir=tmp_path)
     cameras = push.ratings("cameras")
     assert push.rated_sensors == ("surface", "cameras") and cameras is not push
@@ -277,6 +279,39 @@ def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, 
     assert load_skill("push", frame_search=False).rated_sensors == ("surface",)  # given files: those alone
 
 
+def test_a_sensor_search_that_reports_its_own_rating_rates_without_a_searched_model(tmp_path, cube):
+    from dataclasses import replace
+
+    _copy_skill_files("push", tmp_path)
+    _perturbed_policy("push", tmp_path / "cameras" / "push_success_searched.pt", kind="success")
+    frames = tmp_path / "cameras" / "push_frames.json"
+    replace(FrameSearch.load(frames), reports_rating=False).save(frames)
+    with_model = load_skill("push", weights_dir=tmp_path).ratings("cameras")
+    assert with_model._searched_weights == tmp_path / "cameras" / "push_success_searched.pt"
+    replace(FrameSearch.load(frames), reports_rating=True).save(frames)
+    push = load_skill("push", weights_dir=tmp_path)
+    cameras = push.ratings("cameras")
+    assert cameras.searched_model is None and cameras.frame_search.reports_rating
+    assert push.searched_model is not None  # the surface sample's ratings keep theirs
+
+    def scanned():  # the same start and the same camera noise draws each time
+        sim = ap.Simulator(cube, seed=3)
+        sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+        return sim
+
+    params = as_params("push", {"direction": 0.3})
+    sim = scanned()
+    seen = skill_observation(sim, "push", params, cameras.n_points)
+    # what it reports: the search's calibrated rating of the frame it picks, not the searched model's answer
+    p_search = float(cameras.frame_search.calibrate(cameras.frame_search.select(
+        "push", seen, cameras.success_model.predict, sim, decide=cameras.success_model.rate_and_decide)[1]))
+    reported = push.success_probability(scanned(), params)
+    assert reported == pytest.approx(p_search, abs=1e-6)
+    assert reported != pytest.approx(float(with_model.searched_model.predict(seen.obs)), abs=1e-3)
+    shipped = load_skill("push").ratings("cameras")  # as shipped: chosen on validation objects (RECORD.md)
+    assert shipped.frame_search.reports_rating and shipped.searched_model is None
+
+
 def test_a_sensor_skill_of_another_name_or_with_sensors_of_its_own_is_refused():
     push, spin = load_skill("push"), load_skill("spin")
     with pytest.raises(InputError, match="must be a push skill"):
@@ -287,9 +322,11 @@ def test_a_sensor_skill_of_another_name_or_with_sensors_of_its_own_is_refused():
         skills_module.Skill("push", push.model, ratings_by_sensor={"cameras": nested})
 
 
-def _perturbed_policy(name: str, path: Path, seed: int = 0) -> None:
-    """The shipped policy of ``name`` with every weight nudged (a different policy of the same network), at ``path``."""
-    payload, meta = weights_file.load(skills_module.WEIGHTS_DIR / f"{name}.pt", kind="policy", skill=name)
+def _perturbed_policy(name: str, path: Path, seed: int = 0, kind: str = "policy") -> None:
+    """The shipped policy of ``name`` (or its file of another ``kind``: ``"success"``, its searched model) with every
+    weight nudged (a different network of the same shape), at ``path``."""
+    source = f"{name}.pt" if kind == "policy" else weights_file.rating_name(name, "searched")
+    payload, meta = weights_file.load(skills_module.WEIGHTS_DIR / source, kind=kind, skill=name)
     generator = torch.Generator().manual_seed(seed)
     state = {key: value + 0.05 * value.std().nan_to_num() * torch.randn(value.shape, generator=generator)
              if value.is_floating_point() and value.numel() > 1 else value for key, value in payload["model"].items()}

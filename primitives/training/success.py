@@ -873,7 +873,11 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
                   seed_objective=metrics(p[~par], success[~par]) if (~par).any() else None,
                   query_ms=1e3 * bench_query(model.predict, reframe_obs(obs, frames)),
                   frames_per_query=len(frames))
+    # The skill reports the searched model shipped for the sensor, or, where its search says so, the search's own
+    # rating ("all" above): then no searched model is judged unless one is asked for.
+    result["reported"] = "searched model" if args.searched or not search.reports_rating else "frame search"
     searched_paths = ([Path(path) for path in args.searched] if args.searched
+                      else [] if search.reports_rating
                       else [weights_file.rating_path(args.skill, "searched", args.sensor)])
     obs_all, decision = torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)
     for i, searched_path in enumerate(searched_paths):
