@@ -189,8 +189,9 @@ class Skill:
     @property
     def searched_model(self) -> SuccessModel | None:
         """The searched success model (rates the frame-searched skill from the goal frame), or ``None``: the
-        skill acts in the goal frame, or none was given."""
-        if self.frame_search is None or self._searched_weights is None:
+        skill acts in the goal frame, none was given, or its search reports its own rating
+        (:attr:`primitives.frames.FrameSearch.reports_rating`)."""
+        if self.frame_search is None or self.frame_search.reports_rating or self._searched_weights is None:
             return None
         if self._searched is None:
             self._searched = SuccessModel(self.model, load_success_net(self.name, self._searched_weights))
@@ -296,21 +297,13 @@ def load_skill(name: SkillName, weights: str | os.PathLike | None = None,
                 if (own_policy := sensor_policy(name, sensor, directory)) is not None:
                     _require_success_beside(own_policy, success_path)
                     acting = load_policy(own_policy, name)
-                search = shipped_frame_search(name, directory, sensor, trained_on=own)
                 by_sensor[sensor] = Skill(
-                    name, acting, success_weights=success_path, frame_search=search,
-                    searched_weights=searched_path if searched and searched_path.exists()
-                    and not _reports_rating(search) else None)
+                    name, acting, success_weights=success_path,
+                    frame_search=shipped_frame_search(name, directory, sensor, trained_on=own),
+                    searched_weights=searched_path if searched and searched_path.exists() else None)
     return Skill(name, policy, success_weights=success_weights, frame_search=frame_search,
-                 searched_weights=_searched_beside(name, directory, searched and shipped
-                                                   and not _reports_rating(frame_search)),
+                 searched_weights=_searched_beside(name, directory, searched and shipped),
                  ratings_by_sensor=by_sensor)
-
-
-def _reports_rating(search: FrameSearch | None) -> bool:
-    """Whether the skill acting with ``search`` reports that search's own calibrated rating rather than a searched
-    success model (:attr:`primitives.frames.FrameSearch.reports_rating`)."""
-    return search is not None and search.reports_rating
 
 
 def _require_success_beside(policy: Path, success: Path) -> None:

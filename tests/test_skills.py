@@ -4,6 +4,7 @@ it cannot reach is masked out and the policy's next best one is tried), and skil
 from __future__ import annotations
 
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -280,8 +281,6 @@ def test_a_weights_folder_gives_ratings_for_a_sensor_in_its_subfolder(tmp_path, 
 
 
 def test_a_sensor_search_that_reports_its_own_rating_rates_without_a_searched_model(tmp_path, cube):
-    from dataclasses import replace
-
     _copy_skill_files("push", tmp_path)
     _perturbed_policy("push", tmp_path / "cameras" / "push_success_searched.pt", kind="success")
     frames = tmp_path / "cameras" / "push_frames.json"

@@ -875,7 +875,7 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
                   frames_per_query=len(frames))
     # The skill reports the searched model shipped for the sensor, or, where its search says so, the search's own
     # rating ("all" above): then no searched model is judged unless one is asked for.
-    result["reported"] = "searched model" if args.searched or not search.reports_rating else "frame search"
+    result["reported"] = "frame search" if search.reports_rating else "searched model"
     searched_paths = ([Path(path) for path in args.searched] if args.searched
                       else [] if search.reports_rating
                       else [weights_file.rating_path(args.skill, "searched", args.sensor)])
