@@ -55,7 +55,7 @@ from primitives import rewards
 from primitives.frames import FrameSearch, reframe_obs, shipped_frame_search  # noqa: F401 (re-exported)
 from primitives.networks import HybridActorCritic
 from primitives.observation import SkillObservation, skill_observation
-from primitives.params import SKILLS, ParamsLike, SkillName, as_params
+from primitives.params import SKILLS, ParamsLike, SkillName, as_params, motion_stop
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
@@ -154,12 +154,14 @@ class Skill:
         policy's next best contact is tried, up to ``MAX_REACH_RETRIES`` times; the last try is executed as
         it is (a blocked descent then fails without touching anything, an unreachable contact raises).
         Without this, a planner asking for the same push again meets the same contact every time.
+        A spin by an angle ends its motion once the object has turned that far (:func:`primitives.params.motion_stop`).
         The policy and ratings are those for ``sim``'s sensor (:meth:`ratings`).
         """
         rated = self.ratings(getattr(sim, "sensor", None))
         if rated is not self:
             return rated.execute(sim, params)
         seen = self.observe(sim, params)
+        until = motion_stop(self.name, seen.params, sim.object_pose())
         allowed = np.ones(len(seen.points), dtype=bool)
         retries = 0
         while True:
@@ -167,7 +169,7 @@ class Skill:
             last_try = retries >= MAX_REACH_RETRIES
             try:
                 if last_try or sim.approach_clear(contact, normal):
-                    out = sim.execute(contact, motion, normal=normal)
+                    out = sim.execute(contact, motion, normal=normal, until=until)
                     break
             except ReachabilityError:
                 if last_try:

@@ -217,3 +217,28 @@ def test_a_skill_sees_and_does_the_same_for_a_typed_value_and_its_dict():
     assert out_typed.success == out_dict.success and np.allclose(out_typed.pose_after, out_dict.pose_after)
     with pytest.raises(InputError):
         push.act(_finger_sim(cube), params.SpinParams(0.5))
+
+
+def test_motion_stop_ends_a_spin_by_an_angle_once_turned_that_far_about_the_vertical():
+    T0 = make_pose(rot_z(0.3), (0.5, 0.0, 0.04))
+    stop = params.motion_stop("spin", {"angle": math.radians(20.0)}, T0)
+    turned = lambda deg: make_pose(rot_z(0.3 + math.radians(deg)), (0.52, 0.01, 0.04))  # noqa: E731
+    assert not stop(turned(19.0)) and stop(turned(20.5)) and not stop(turned(-25.0))
+    back = params.motion_stop("spin", params.SpinParams(-math.radians(20.0)), T0)
+    assert back(turned(-21.0)) and not back(turned(21.0))
+    # a roll about a horizontal axis is no turn about the vertical
+    rolled = T0.copy()
+    rolled[:3, :3] = T0[:3, :3] @ np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
+    assert not stop(rolled)
+
+
+@pytest.mark.parametrize("skill, asked", [("spin", None), ("push", {"direction": 0.4}), ("roll", None)])
+def test_motion_stop_lets_other_calls_run_their_full_motion(skill, asked):
+    assert params.motion_stop(skill, asked, np.eye(4)) is None
+
+
+def test_motion_stop_refuses_bad_input():
+    with pytest.raises(InputError):
+        params.motion_stop("spin", {"angle": 3.0}, np.eye(4))
+    with pytest.raises(InputError):
+        params.motion_stop("spin", {"angle": 0.4}, np.eye(3))

@@ -10,7 +10,7 @@ import trimesh
 
 import affordplan as ap
 from affordplan.errors import InputError
-from primitives import rewards
+from primitives import params, rewards
 
 
 def face_centre_push(sim: ap.Simulator, obj: ap.ObjectModel, stroke: float) -> ap.Outcome:
@@ -200,3 +200,25 @@ def test_a_snapshot_lets_another_primitive_start_from_the_same_state(cube):
         sim.restore("start")
     with pytest.raises(InputError):
         sim.restore(ap.Simulator(cube).snapshot())  # another simulator's, even of the same scene
+
+
+def test_a_motion_ends_where_until_holds_and_the_object_stops_turning_there(lunch_box):
+    """The corner push above turns the box about 32 deg clockwise; asked to stop at 15 deg it turns 15 +- 3."""
+    hx, hy, _ = lunch_box.mesh.extents / 2
+    turns = {}
+    for asked in (None, -math.radians(15.0)):
+        sim = ap.Simulator(lunch_box)
+        T0 = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+        until = None if asked is None else params.motion_stop("spin", {"angle": asked}, T0)
+        out = sim.execute(T0[:3, 3] + np.array([-hx, 0.8 * hy, 0.0]), (1.0, 0.0, 0.0), until=until)
+        assert out.valid and out.stopped == (asked is not None)
+        turns[asked] = rewards.signed_turn_deg(rewards.motion(out.pose_before, out.pose_after))
+    assert turns[None] < -25.0
+    assert abs(turns[-math.radians(15.0)] + 15.0) <= 3.0
+
+
+def test_until_must_be_callable(cube):
+    sim = ap.Simulator(cube)
+    T0 = sim.reset()
+    with pytest.raises(InputError, match="until"):
+        sim.execute(T0[:3, 3], (1.0, 0.0, 0.0), until=3)

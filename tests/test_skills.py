@@ -30,7 +30,7 @@ class _ReachLimited(ap.Simulator):
         self.refuse = refuse
         self.asked: list[np.ndarray] = []
 
-    def execute(self, contact, motion, normal=None):
+    def execute(self, contact, motion, normal=None, until=None):
         self.asked.append(np.asarray(contact, dtype=float))
         if len(self.asked) <= self.refuse:
             raise ReachabilityError("the arm cannot reach this contact (test)")
@@ -71,7 +71,7 @@ class _DescentBlocked(ap.Simulator):
         self.checked.append(np.asarray(contact, dtype=float))
         return len(self.checked) > self.block
 
-    def execute(self, contact, motion, normal=None):
+    def execute(self, contact, motion, normal=None, until=None):
         self.executed.append(np.asarray(contact, dtype=float))
         return super().execute(contact, motion, normal=normal)
 

@@ -3,7 +3,8 @@
 A primitive follows HACMan's protocol (docs/architecture.md): the fingertip is brought 4 cm out along the
 contact's outward normal (the finger teleports there; the arm transits at a safe height above the
 obstacles and the object, then descends), servoes to 2 cm, then to the contact (the tip's surface touching it); the
-motion is 3 control steps that each move the target by ``motion * 3 cm`` over 0.5 s; the finger
+motion is 3 control steps that each move the target by ``motion * 3 cm`` over 0.5 s (a caller's ``until``
+may end it early: the fingertip then holds where it is); the finger
 backs off 2 cm along the normal, rises 5 cm and leaves (the arm rises to the safe height), and the object settles (until
 still, at most 2 s).
 
@@ -57,6 +58,7 @@ class Outcome:
         success: set by skills that judge the outcome; ``None`` here.
         arm_collisions: (arm geom, obstacle or table geom) name pairs that touched during the
             primitive (arm pusher; the fingertip touching the table is not counted).
+        stopped: the motion ended before its last control step because the caller's ``until`` held.
     """
 
     pose_before: np.ndarray
@@ -72,6 +74,7 @@ class Outcome:
     motion: np.ndarray = field(default_factory=lambda: np.zeros(3))
     success: bool | None = None
     arm_collisions: tuple[tuple[str, str], ...] = ()
+    stopped: bool = False
 
 
 # Guard faults after which the object is left to settle (the primitive stays invalid): transients of a
@@ -322,13 +325,20 @@ class Simulator:
         self._ik.check_reachable(points, np.array(HOME))
         self._pusher.home()
 
-    def execute(self, contact, motion, normal=None) -> Outcome:
+    def execute(self, contact, motion, normal=None,
+                until: Callable[[np.ndarray], bool] | None = None) -> Outcome:
         """Run one primitive: approach ``contact`` (world point, metres), then move by ``motion``.
 
         ``motion`` is (3,) in [-1, 1] (values beyond are clipped): each of the 3 control steps moves
         the fingertip target by ``motion * 3 cm``. ``normal`` is the outward surface normal at the
-        contact; by default that of the nearest surface sample.
+        contact; by default that of the nearest surface sample. ``until``, when given, is called with the
+        object's world pose ``T_world_object`` (4x4) after every 20 ms of the motion; once it returns true
+        the fingertip target holds at the fingertip's position, the motion ends there and the retract follows
+        (``Outcome.stopped``): a spin by an angle ends where the object has turned that far
+        (:func:`primitives.params.motion_stop`).
         """
+        if until is not None and not callable(until):
+            raise InputError(f"until must be a function of the object's pose or None, got {describe(until)}")
         contact = _vector(contact, "contact")
         motion = np.clip(as_vector("motion", motion, 3), -1.0, 1.0)  # any finite motion; clipped as documented
         normal, touch, pre = self._approach_points(contact, normal)
@@ -337,7 +347,7 @@ class Simulator:
         pose_before = self.object_pose()
         if self._ik is not None:
             self._check_reach([pre, touch])
-        result = dict(approach_ok=False, valid=True, invalid_reason=None)
+        result = dict(approach_ok=False, valid=True, invalid_reason=None, stopped=False)
         self._guard.arm()
         self._collisions.clear()
         self._tracking.clear()
@@ -353,7 +363,9 @@ class Simulator:
                     target = touch
                     for _ in range(p.motion_steps):
                         nxt = self._clamp(target + p.motion_step * motion)
-                        self._servo(target, nxt, p.motion_step_time, track=True)
+                        if self._servo(target, nxt, p.motion_step_time, track=True, until=until):
+                            result["stopped"] = True
+                            break
                         target = nxt
                 self._retract(normal)
             self._settle(p.settle_time_max)
@@ -405,8 +417,11 @@ class Simulator:
         self._servo(back, back + np.array([0.0, 0.0, p.retract_height]), p.retract_time)
         self._pusher.leave(self._servo)
 
-    def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False) -> None:
-        """Move the fingertip target linearly from ``start`` to ``end``; ``track`` logs the error."""
+    def _servo(self, start: np.ndarray, end: np.ndarray, duration: float, track: bool = False,
+               until: Callable[[np.ndarray], bool] | None = None) -> bool:
+        """Move the fingertip target linearly from ``start`` to ``end``; ``track`` logs the error. With ``until``,
+        checked on the object's pose after every chunk: once it holds, the target holds at the fingertip and this
+        returns ``True`` (the move ended early)."""
         n_chunks = self._chunks(duration)
         for k in range(1, n_chunks + 1):
             target = start + (end - start) * (k / n_chunks)
@@ -414,6 +429,10 @@ class Simulator:
             self._step(CHUNK_STEPS)
             if track:
                 self._tracking.append(float(np.linalg.norm(self._pusher.tip() - target)))
+            if until is not None and until(self.object_pose()):
+                self._pusher.command(self._pusher.tip())
+                return True
+        return False
 
     def _settle(self, max_time: float, guarded: bool = True) -> None:
         p = self.protocol

@@ -229,7 +229,9 @@ class PrimitiveEnv:
         """Execute the primitive at point ``index`` with goal-frame ``motion``; the episode ends here."""
         assert self.sim is not None and self.seen is not None, "call reset() first"
         seen = self.seen
-        out = self.sim.execute(seen.points[index], seen.motion_to_world(motion), normal=seen.normals[index])
+        until = skill_params.motion_stop(self.config.primitive, self.params, self.sim.object_pose())
+        out = self.sim.execute(seen.points[index], seen.motion_to_world(motion), normal=seen.normals[index],
+                               until=until)
         name, obj = self.config.primitive, self.sim.obj
         reward = -rewards.loss(name, out.pose_before, out.pose_after, self.params, obj)
         success = rewards.success(name, out.pose_before, out.pose_after, self.params, obj)
