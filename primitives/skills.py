@@ -145,7 +145,7 @@ class Skill:
         contact, _, motion = self._decide(self.observe(sim, params))
         return contact, motion
 
-    def execute(self, sim: Simulator, params: ParamsLike = None) -> Outcome:
+    def execute(self, sim: Simulator, params: ParamsLike = None, stop_at_angle: bool = True) -> Outcome:
         """Act and execute; ``Outcome.success``: the criterion for ``params`` was met (and the sample valid).
 
         With the arm, a contact it cannot reach (:class:`ReachabilityError`, raised before any physics) or
@@ -154,14 +154,16 @@ class Skill:
         policy's next best contact is tried, up to ``MAX_REACH_RETRIES`` times; the last try is executed as
         it is (a blocked descent then fails without touching anything, an unreachable contact raises).
         Without this, a planner asking for the same push again meets the same contact every time.
-        A spin by an angle ends its motion once the object has turned that far (:func:`primitives.params.motion_stop`).
+        A spin by an angle ends its motion once the object has turned that far (:func:`primitives.params.motion_stop`);
+        ``stop_at_angle=False`` runs its full motion, as plans execute spins (on the 200 validation plan tasks the
+        stopping spin cost plans 9.29 -> 10.26 primitives over the tasks both reached, 153 -> 150 reached).
         The policy and ratings are those for ``sim``'s sensor (:meth:`ratings`).
         """
         rated = self.ratings(getattr(sim, "sensor", None))
         if rated is not self:
-            return rated.execute(sim, params)
+            return rated.execute(sim, params, stop_at_angle)
         seen = self.observe(sim, params)
-        until = motion_stop(self.name, seen.params, sim.object_pose())
+        until = motion_stop(self.name, seen.params, sim.object_pose()) if stop_at_angle else None
         allowed = np.ones(len(seen.points), dtype=bool)
         retries = 0
         while True:

@@ -386,3 +386,28 @@ def test_a_sensor_folder_policy_serves_that_sensor_even_where_the_main_policy_wa
     p, contact = _rated(push, cube, "surface", {"direction": 0.7})
     p_alone, contact_alone = _rated(alone, cube, "surface", {"direction": 0.7})
     assert p == pytest.approx(p_alone) and np.allclose(contact, contact_alone)
+
+
+class _Recording(ap.Simulator):
+    """A finger simulator that records the ``until`` each primitive is given."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.untils: list = []
+
+    def execute(self, contact, motion, normal=None, until=None):
+        self.untils.append(until)
+        return super().execute(contact, motion, normal=normal, until=until)
+
+
+def test_a_spin_by_an_angle_stops_at_it_unless_told_to_run_its_full_motion(lunch_box):
+    import math
+
+    spin = load_skill("spin")
+    sim = _Recording(lunch_box, seed=0)
+    for stop in (True, False):
+        sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+        spin.execute(sim, {"angle": math.radians(30.0)}, stop_at_angle=stop)
+    sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+    spin.execute(sim, None)  # the seed's objective: no angle to stop at
+    assert callable(sim.untils[0]) and sim.untils[1] is None and sim.untils[2] is None
