@@ -343,14 +343,15 @@ def motion_stop(skill: str, params: ParamsLike, T_world_object: np.ndarray) -> C
 
     A spin by an angle ends once the object has turned that far in the asked sense about the vertical (the yaw of
     ``R = R_now R_before^T``, ``atan2(R[1, 0], R[0, 0])``), read from the object's pose every 20 ms as closed-loop
-    execution reads it between calls. (The criterion's own measure, the rotation angle signed by its axis, also counts
-    a can on its side rolling about its length as turning: stopping on it succeeded 0.629 against 0.679 on the 240
-    validation starts below.) The policy picks
-    the contact and the motion's direction; how far the object turns is what a fingertip cannot choose open-loop (on
-    household meshes the policy's turn hardly follows the asked angle). On ``housekeep:validation`` with camera clouds,
-    96 spins by an asked angle succeeded 0.438 -> 0.740; the same with 2 deg of noise on each reading and one reading
-    every 100 ms, 0.740. The seed's objective, pushes and rolls run their full motion: a push that stops at 5 cm
-    gained 3 of 96 starts (0.417 -> 0.448), a roll that stops half-way tipped back (0.323 -> 0.115).
+    execution reads it between calls. The policy picks the contact and the motion's direction; how far the object
+    turns is what a fingertip cannot choose open-loop (on household meshes the policy's turn hardly follows the asked
+    angle). One stroke on ``housekeep:validation`` with camera clouds, 240 starts (``python -m primitives.evaluate
+    spin --params random --frames shipped --objects housekeep:validation --trials 20``): 0.396 -> 0.679. Stopping on
+    the criterion's own measure instead (the rotation angle signed by its axis, which also counts a can on its side
+    rolling about its length as turning) gave 0.629 on the same starts. On 96 of them, 2 deg of noise on each reading
+    and one reading every 100 ms did as well as the exact pose (0.740 both). The seed's objective, pushes and rolls
+    run their full motion: a push that stops at 5 cm gained 3 of 96 starts (0.417 -> 0.448), a roll that stops
+    half-way tipped back (0.323 -> 0.115).
 
     Raises:
         InputError: ``params`` that ``skill`` does not take (:func:`check`), or a pose that is not a 4x4 of finite

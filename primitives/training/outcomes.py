@@ -11,8 +11,8 @@ the workspace and a yaw; :class:`primitives.training.env.EnvConfig`), builds a f
 showing the skills' sensor (:func:`primitives.skills.skills_sensor`), draws a parameter as the planner asks them
 (push ``{"direction": U(-pi, pi)}``; spin ``{"angle": +-U(SPIN_MIN, SPIN_MAX)}``; roll a target among
 :func:`primitives.params.roll_targets`, the start skipped when there is none), asks the shipped skill's success
-model ``p = skill.success_probability(sim, params)`` (what the planner knows when it plans) and then executes it,
-recording per row (:data:`COLUMNS`):
+model ``p = skill.success_probability(sim, params)`` (what the planner knows when it plans) and then executes it as
+plans do (a spin's full motion, ``stop_at_angle=False``), recording per row (:data:`COLUMNS`):
 
 - ``p``: the strict success probability; ``param``: the parameter's value (radians, or the target state);
 - ``success``: the strict criterion (:func:`primitives.rewards.success`) and a valid sample;
@@ -240,7 +240,7 @@ def collect(skill: str, skills: Mapping[str, Skill], rollouts: int, objects: str
             skipped += 1
             continue
         p = skills[skill].success_probability(sim, params)
-        out = skills[skill].execute(sim, params)
+        out = skills[skill].execute(sim, params, stop_at_angle=False)  # as plans execute their calls
         m = measure(obj, skill, params, out.pose_before, out.pose_after)
         row = dict(m, p=p, param=next(iter(params.values())), success=bool(out.success), valid=bool(out.valid),
                    object=names.setdefault(object_name(key), len(names)),
