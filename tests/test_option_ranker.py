@@ -128,9 +128,14 @@ def test_a_search_with_a_ranker_acts_where_the_ranker_says_and_reports_that_fram
         ranked.select("spin", seen, rating, sim)
     with pytest.raises(InputError, match="ranker"):
         FrameSearch(6, False, ranker_file="spin_ranker.pt")
-    asked = skill_observation(sim, "spin", {"angle": 0.5}, 64)  # a request with a parameter: the ratings pick
-    assert ranked.ranks(None) and not ranked.ranks(asked.params) and not plain.ranks(None)
-    chosen, p = ranked.select("spin", asked, rating, sim)
+    asked = skill_observation(sim, "spin", {"angle": 0.5}, 64)  # a request with a parameter: the ranker picks too
+    assert ranked.ranks(None) and ranked.ranks(asked.params) and not plain.ranks(None)
+    asked_frames = free_frames("spin", asked.params, 6, False)
+    chosen, p = ranked.select("spin", asked, rating, sim, decide=decide)
+    assert np.allclose(chosen.A_frame_world, asked_frames[4] @ asked.A_frame_world)
+    assert chosen.params == asked.params and chosen.acted_as is None  # judged by the asked angle
+    assert p == pytest.approx(np.linspace(0.8, 0.3, 6)[4])
+    chosen, p = plain.select("spin", asked, rating, sim)  # without a ranker the ratings pick
     assert np.allclose(chosen.A_frame_world, asked.A_frame_world) and p == pytest.approx(0.8)
 
 
@@ -164,7 +169,7 @@ def test_the_shipped_spin_ranks_its_options_with_camera_clouds_only():
     spin = load_skill("spin")
     cameras = spin.ratings("cameras")
     assert spin.rated_sensors == ("surface", "cameras") and spin.frame_search.ranker is None
-    assert cameras.frame_search.ranks(None) and not cameras.frame_search.ranks({"angle": 0.4})
+    assert cameras.frame_search.ranks(None) and cameras.frame_search.ranks({"angle": 0.4})
     assert cameras._success_weights == weights_file.SHIPPED_DIR / "spin_success.pt"  # the policy's own
     assert (cameras.frame_search.turns, cameras.frame_search.platt) == (spin.frame_search.turns,
                                                                        spin.frame_search.platt)
