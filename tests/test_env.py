@@ -61,3 +61,26 @@ def test_env_refuses_a_config_it_cannot_run(field, value, words):
     assert words in str(info.value)
     env = PrimitiveEnv(EnvConfig("push", objects=("cube",), n_points=16, sim_cache=1, model_cache=0))
     assert env.reset().shape == (16, 9)  # the least values run
+
+
+def test_full_motion_runs_a_spin_by_an_angle_to_the_end_of_its_motion():
+    """The same spins by an angle from the same starts: by default a spin that turns the box the asked angle ends
+    its motion there (``Outcome.stopped``), with ``full_motion`` none does, and a spin that never got that far is the
+    same primitive either way."""
+    def run(full_motion):
+        env = PrimitiveEnv(EnvConfig("spin", objects=("lunch_box",), n_points=64, p_params=1.0,
+                                     full_motion=full_motion), seed=3)
+        rng, rows = np.random.default_rng(1), []
+        for _ in range(16):
+            env.reset(params={"angle": 0.3})
+            res = env.step(int(rng.integers(64)), rng.uniform(-1, 1, size=3))
+            rows.append((res.outcome.stopped, res.outcome.pose_after))
+        env.close()
+        return rows
+
+    stopping, full = run(False), run(True)
+    assert any(stopped for stopped, _ in stopping) and not all(stopped for stopped, _ in stopping)
+    assert not any(stopped for stopped, _ in full)
+    for (stopped, T_after), (_, T_full) in zip(stopping, full):
+        if not stopped:
+            assert np.allclose(T_after, T_full, atol=1e-9)

@@ -247,8 +247,8 @@ def test_a_searched_success_model_rates_the_searched_skill_from_the_goal_frame(t
                   searched_weights=tmp_path / "searched.pt")
     obj = ap.load_object("lunch_box")
 
-    def fresh():
-        sim = ap.Simulator(obj, seed=2)
+    def fresh():  # the clouds whose ratings ``skill`` carries (the policy's own)
+        sim = ap.Simulator(obj, seed=2, sensor=shipped.sensor)
         sim.reset()
         return sim
 

@@ -13,10 +13,15 @@ from primitives.research.sensitivity import VARIANTS, Sensitivity, StartDecision
 def test_the_base_outcomes_are_the_frame_ceilings_and_zero_sized_variants_repeat_them():
     """Each drawn decision's base outcome is that option's outcome when the frame ceiling executes every option
     from the same evaluation start; with a 0 deg turn and a 0 mm move every variant executes the base decision
-    again (the scene shift resets the simulator's data to the same pose) and must end the same way."""
+    again (the scene shift resets the simulator's data to the same pose) and must end the same way. Both search with
+    the policy's own frames file, which has no option ranker, so the ceiling reports the success model's ratings as
+    the sensitivity does (with the camera search's ranker it would report the ranker's scores)."""
+    from primitives.weights_file import SHIPPED_DIR
+
+    frames = str(SHIPPED_DIR / "spin_frames.json")
     result = sensitivity("spin", starts=2, params="random", options=3, seed=1234, motion_rad=0.0, contact_m=0.0,
-                         progress=False)
-    ceiling = frame_ceiling("spin", starts=2, params="random", seed=1234, progress=False)
+                         frames=frames, progress=False)
+    ceiling = frame_ceiling("spin", starts=2, params="random", seed=1234, frames=frames, progress=False)
     for mine, every in zip(result.starts, ceiling.starts, strict=True):
         assert len(mine.row) == 3 and len(set(mine.row.tolist())) == 3
         assert np.array_equal(mine.base, every.success[mine.row])

@@ -467,3 +467,13 @@ def test_searched_rollouts_act_with_the_frame_search_and_ratings_of_the_asked_se
         success.main(["train", "spin", "--frames", "shipped", "--sensor", "cameras", "--rollouts", "1",
                       "--out", str(tmp_path)])
     assert asked == {"frames": "cameras", "ranked": True, "model": "cameras"}
+
+
+def test_train_command_records_a_collection_of_full_motion_spins(tmp_path):
+    """``--full-motion``: the spins by an angle collected run their full motion (as plans execute them); the model
+    file records it, in its info and in the command that remakes it."""
+    rc = success.main(["train", "spin", "--rollouts", "12", "--epochs", "1", "--seed", "2", "--full-motion",
+                       "--out", str(tmp_path), "--json"])
+    assert rc == 0
+    info = weights_file.load(tmp_path / "success.pt", kind="success")[0]["info"]
+    assert info["full_motion"] is True and info["command"].endswith("--full-motion")

@@ -114,3 +114,18 @@ def _session(sid: int) -> list[str]:
         except OSError:
             continue
     return found
+
+
+def test_resume_keeps_the_spin_a_run_trained_with(tmp_path):
+    """A run trained with spins stopping at the angle does not resume with their full motion, and a checkpoint
+    written before the stop existed (no ``full_motion`` in its configuration) resumes only with ``--full-motion``."""
+    train(_config(tmp_path), progress=False)
+    with pytest.raises(InputError, match="--full-motion False there, True now"):
+        train(_config(tmp_path, full_motion=True), resume=True, progress=False)
+    from primitives.training.train import check_resume
+
+    before = {k: v for k, v in ckpt.load(tmp_path / "checkpoint.pt", skill="push")["config"].items()
+              if k != "full_motion"}
+    check_resume(before, _config(tmp_path, full_motion=True), tmp_path / "checkpoint.pt")
+    with pytest.raises(InputError, match="--full-motion True there, False now"):
+        check_resume(before, _config(tmp_path), tmp_path / "checkpoint.pt")

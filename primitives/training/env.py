@@ -53,6 +53,9 @@ class EnvConfig:
     :func:`affordplan.objects.housekeep.names`), several of these joined by ``+`` (each episode draws a group
     uniformly, then an object in it), or a tuple of catalogue names / mesh paths.
     ``sensor``: how the policy sees the object (:meth:`affordplan.Simulator.point_cloud`).
+    ``full_motion``: a spin by an angle runs its full motion instead of ending where the object has turned that far
+    (:func:`primitives.params.motion_stop`): the primitive as plans execute it, and as every file fitted before the
+    stop (2026-12-06) was collected or trained.
     """
 
     primitive: str = "push"
@@ -68,6 +71,7 @@ class EnvConfig:
     episodes_per_object: int = 8  # consecutive episodes on one drawn object: amortises its setup
     p_params: float = 0.0  # probability that an episode asks for a parameter (0: the seed's objective)
     sensor: str = "cameras"
+    full_motion: bool = False
 
 
 @dataclass
@@ -229,7 +233,8 @@ class PrimitiveEnv:
         """Execute the primitive at point ``index`` with goal-frame ``motion``; the episode ends here."""
         assert self.sim is not None and self.seen is not None, "call reset() first"
         seen = self.seen
-        until = skill_params.motion_stop(self.config.primitive, self.params, self.sim.object_pose())
+        until = None if self.config.full_motion else skill_params.motion_stop(self.config.primitive, self.params,
+                                                                               self.sim.object_pose())
         out = self.sim.execute(seen.points[index], seen.motion_to_world(motion), normal=seen.normals[index],
                                until=until)
         name, obj = self.config.primitive, self.sim.obj

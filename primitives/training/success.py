@@ -180,11 +180,13 @@ class _RolloutRows:
 
 @torch.no_grad()
 def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train", n_objects: int = 500,
-            seed: int = 0, p_params: float = 0.85, progress: bool = True, sensor: str = "cameras") -> Rollouts:
+            seed: int = 0, p_params: float = 0.85, progress: bool = True, sensor: str = "cameras",
+            full_motion: bool = False) -> Rollouts:
     """``n`` valid greedy rollouts of ``policy`` on the objects ``split`` (:attr:`EnvConfig.objects`: a procedural
-    split, ``housekeep:SPLIT``, or several joined by ``+``), seen by ``sensor``."""
+    split, ``housekeep:SPLIT``, or several joined by ``+``), seen by ``sensor``; ``full_motion``:
+    :attr:`EnvConfig.full_motion`."""
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
-                                 episodes_per_object=4, sensor=sensor), seed=seed)
+                                 episodes_per_object=4, sensor=sensor, full_motion=full_motion), seed=seed)
     rows = _RolloutRows()
     bar = tqdm(total=n, desc=f"rollouts {skill} ({split})", disable=not progress, unit="rollout", mininterval=2.0)
     while len(rows) < n:
@@ -204,7 +206,8 @@ def collect(policy: HybridActorCritic, skill: str, n: int, split: str = "train",
 @torch.no_grad()
 def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split: str = "train",
                          n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
-                         progress: bool = True, sensor: str = "cameras") -> tuple[np.ndarray, Rollouts]:
+                         progress: bool = True, sensor: str = "cameras",
+                         full_motion: bool = False) -> tuple[np.ndarray, Rollouts]:
     """``n`` valid greedy rollouts acting in the frame of ``search`` (:class:`primitives.frames.FrameSearch`)
     that ``model`` rates likeliest.
 
@@ -214,7 +217,7 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
     """
     from primitives.policy import greedy_action
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
-                                 episodes_per_object=4, sensor=sensor), seed=seed)
+                                 episodes_per_object=4, sensor=sensor, full_motion=full_motion), seed=seed)
     rating, rows = [], _RolloutRows()
     bar = tqdm(total=n, desc=f"frame-search rollouts {skill} ({split})", disable=not progress, unit="rollout",
                mininterval=2.0)
@@ -237,7 +240,8 @@ def collect_frame_search(model: SuccessModel, skill: str, n: int, search, split:
 @torch.no_grad()
 def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_start: int, split: str = "train",
                      n_objects: int = 500, seed: int = 0, p_params: float = 0.85,
-                     progress: bool = True, neighbours: bool = False, sensor: str = "cameras") -> Rollouts:
+                     progress: bool = True, neighbours: bool = False, sensor: str = "cameras",
+                     full_motion: bool = False) -> Rollouts:
     """``n`` valid greedy rollouts of ``policy``, ``per_start`` from each start: the start seen in that many of the
     options ``search`` rates for its request (:meth:`primitives.frames.FrameSearch.options`: its free frames, and
     for the seed's objective with stand-ins each stand-in request in its own free frames), drawn without
@@ -258,7 +262,7 @@ def collect_contrast(policy: HybridActorCritic, skill: str, n: int, search, per_
     noise, at five simulations a rollout.
     """
     env = PrimitiveEnv(EnvConfig(skill, objects=split, n_objects=n_objects, p_params=p_params,
-                                 episodes_per_object=4, sensor=sensor), seed=seed)
+                                 episodes_per_object=4, sensor=sensor, full_motion=full_motion), seed=seed)
     rng = np.random.default_rng([seed, 1])  # the options drawn; apart from the environment's own stream
     rows = _RolloutRows()
     bar = tqdm(total=n, desc=f"frame-contrast rollouts {skill} ({split})", disable=not progress, unit="rollout",
@@ -618,6 +622,10 @@ def build_parser() -> argparse.ArgumentParser:
             "--sensor", choices=SENSORS, default="cameras",
             help="how the skill sees the object (surface: the privileged sample, for ablations) "
                  "(default: %(default)s)")
+        sub.choices[name].add_argument(
+            "--full-motion", action="store_true",
+            help="spins by an angle run their full motion instead of stopping at the angle: as plans execute them, "
+                 "and as every file fitted before the stop (2026-12-06) was collected")
     for name in ("train", "frames"):
         sub.choices[name].add_argument(
             "--workers", type=int, default=1,
@@ -738,23 +746,25 @@ def _run(args: argparse.Namespace) -> int:
             data = Rollouts.concat(collect_parallel(
                 collect_contrast, (policy, args.skill), args.rollouts, args.seed, args.workers,
                 progress=not args.json, search=contrast, per_start=args.contrast, split=args.objects,
-                neighbours=args.neighbours, sensor=args.sensor))
+                neighbours=args.neighbours, sensor=args.sensor, full_motion=args.full_motion))
         elif searched:
             rater = SuccessModel(policy, load_success_net(args.skill, args.model, sensor=args.sensor))
             data = Rollouts.concat([part[1] for part in collect_parallel(
                 collect_frame_search, (rater, args.skill), args.rollouts, args.seed, args.workers,
-                progress=not args.json, search=search, split=args.objects, sensor=args.sensor)])
+                progress=not args.json, search=search, split=args.objects, sensor=args.sensor,
+                full_motion=args.full_motion)])
         else:
             data = Rollouts.concat(collect_parallel(collect, (policy, args.skill), args.rollouts, args.seed,
                                                     args.workers, progress=not args.json, split=args.objects,
-                                                    sensor=args.sensor))
+                                                    sensor=args.sensor, full_motion=args.full_motion))
         if not args.rollouts_from:
             data.save(cache)
         views = FrameViews.of(data, policy, args.skill, search, progress=not args.json) if args.views else None
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
                         views=views, encoder=args.encoder, rank_weight=args.rank_weight)
         info.update(skill=args.skill, rollouts=len(data) if args.rollouts_from else args.rollouts, seed=args.seed,
-                    workers=args.workers, policy=args.policy or "shipped", objects=args.objects, sensor=args.sensor)
+                    workers=args.workers, policy=args.policy or "shipped", objects=args.objects, sensor=args.sensor,
+                    full_motion=args.full_motion)
         if args.rollouts_from:
             info.update(rollouts_from=args.rollouts_from)
         if searched:
@@ -783,7 +793,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.frames is not None:
         return _evaluate_frames(args, model)
     data = collect(policy, args.skill, args.rollouts, args.objects, n_objects=200, seed=args.seed,
-                   progress=not args.json, sensor=args.sensor)
+                   progress=not args.json, sensor=args.sensor, full_motion=args.full_motion)
     with torch.no_grad():
         p = net(torch.from_numpy(data.obs.astype(np.float32)), torch.from_numpy(data.decision)).numpy()
     result = dict(skill=args.skill, objects=_objects_label(args.objects), sensor=args.sensor,
@@ -797,9 +807,11 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _objects_args(args: argparse.Namespace) -> str:
-    """The ``--objects`` / ``--sensor`` part of a recorded command (empty where they are the defaults)."""
+    """The ``--objects`` / ``--sensor`` / ``--full-motion`` part of a recorded command (empty where they are the
+    defaults)."""
     return ((f" --objects {args.objects}" if args.objects != "train" else "")
-            + (f" --sensor {args.sensor}" if args.sensor != "cameras" else ""))
+            + (f" --sensor {args.sensor}" if args.sensor != "cameras" else "")
+            + (" --full-motion" if args.full_motion else ""))
 
 
 def _objects_label(objects: str) -> str:
@@ -818,7 +830,8 @@ def _run_frames(args: argparse.Namespace) -> int:
     model = SuccessModel(load_policy(args.policy, args.skill), load_success_net(args.skill, args.model))
     t0 = time.perf_counter()
     parts = collect_parallel(collect_frame_search, (model, args.skill), args.rollouts, args.seed, args.workers,
-                             progress=not args.json, search=search, split=args.objects, sensor=args.sensor)
+                             progress=not args.json, search=search, split=args.objects, sensor=args.sensor,
+                             full_motion=args.full_motion)
     rating, data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
     success, par = data.success, data.parameterised
     platt = fit_frame_calibration(rating[par], success[par])
@@ -835,7 +848,7 @@ def _run_frames(args: argparse.Namespace) -> int:
         search = replace(search, stand_ins=asked.stand_ins)
         parts = collect_parallel(collect_frame_search, (model, args.skill), args.stand_in_rollouts, args.seed,
                                  args.workers, progress=not args.json, search=search, split=args.objects, p_params=0.0,
-                                 sensor=args.sensor)
+                                 sensor=args.sensor, full_motion=args.full_motion)
         score, seed_data = np.concatenate([r for r, _ in parts]), Rollouts.concat([d for _, d in parts])
         search = replace(search, platt_stand_ins=fit_frame_calibration(score, seed_data.success))
         info.update(stand_ins=args.stand_ins, stand_in_rollouts=args.stand_in_rollouts,
@@ -863,7 +876,8 @@ def _evaluate_frames(args: argparse.Namespace, model: SuccessModel) -> int:
     searched skill from the goal frame alone (the shipped ``{skill}_success_searched.pt``, or ``--searched``)."""
     search = load_frame_search(args.skill, args.frames, sensor=args.sensor)
     rating, data = collect_frame_search(model, args.skill, args.rollouts, search, args.objects, n_objects=200,
-                                        seed=args.seed, progress=not args.json, sensor=args.sensor)
+                                        seed=args.seed, progress=not args.json, sensor=args.sensor,
+                                        full_motion=args.full_motion)
     success, par = data.success, data.parameterised
     p = search.calibrate(rating, par)
     obs = data.obs[0].astype(np.float32)

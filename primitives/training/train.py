@@ -95,6 +95,7 @@ class TrainConfig:
     # each drawn half the time (primitives.training.env.EnvConfig.objects).
     objects: str | tuple[str, ...] = "train+housekeep:training"
     sensor: str = "cameras"  # how the policy sees the object (affordplan.Simulator.point_cloud)
+    full_motion: bool = False  # spins by an angle run their full motion (EnvConfig.full_motion), as before the stop
     n_objects: int = 500
     p_params: float = 0.75  # share of episodes that ask for a parameter (0: the seed's objective only)
     init: str | None = None  # weights to start from (ignored on --resume)
@@ -122,7 +123,7 @@ class TrainConfig:
 
 def env_config(cfg: TrainConfig) -> EnvConfig:
     return EnvConfig(cfg.primitive, objects=cfg.objects, n_objects=cfg.n_objects, n_points=cfg.n_points,
-                     p_params=cfg.p_params, sim_cache=cfg.sim_cache, sensor=cfg.sensor)
+                     p_params=cfg.p_params, sim_cache=cfg.sim_cache, sensor=cfg.sensor, full_motion=cfg.full_motion)
 
 
 def exploration(cfg: TrainConfig) -> Exploration:
@@ -131,14 +132,17 @@ def exploration(cfg: TrainConfig) -> Exploration:
 
 
 # Settings the command line sets; the others are TrainConfig fields only.
-_CLI_SETTINGS = frozenset({"objects", "sensor",
+_CLI_SETTINGS = frozenset({"objects", "sensor", "full_motion",
                            "steps", "workers", "max_minutes", "checkpoint_minutes", "lr", "p_params", "p_scripted",
                            "batch_size", "replay_size", "learning_starts", "weight_sync_updates", "n_points",
                            "torch_threads", "replay_ratio", "precision"})
 
 
 # Settings a resumed run must share with its checkpoint: what it learns, what it sees, what its replay holds.
-RESUME_MUST_MATCH = ("primitive", "objects", "n_objects", "sensor", "n_points", "replay_size", "p_params")
+RESUME_MUST_MATCH = ("primitive", "objects", "n_objects", "sensor", "full_motion", "n_points", "replay_size",
+                     "p_params")
+# What a checkpoint written before a setting existed ran with (it is missing from its saved configuration).
+SETTING_BEFORE_IT_EXISTED = {"full_motion": True}
 
 
 class RunLock:
@@ -171,8 +175,9 @@ class RunLock:
 def check_resume(saved_config: dict, cfg: TrainConfig, path: Path) -> None:
     """Raise :class:`InputError` naming every setting in ``RESUME_MUST_MATCH`` where the checkpoint's run differs."""
     now = asdict(cfg)
-    differ = [f"{_setting(k)} {str(saved_config.get(k))[:60]} there, {str(now[k])[:60]} now"
-              for k in RESUME_MUST_MATCH if _normal(saved_config.get(k)) != _normal(now[k])]
+    then = {k: saved_config.get(k, SETTING_BEFORE_IT_EXISTED.get(k)) for k in RESUME_MUST_MATCH}
+    differ = [f"{_setting(k)} {str(then[k])[:60]} there, {str(now[k])[:60]} now"
+              for k in RESUME_MUST_MATCH if _normal(then[k]) != _normal(now[k])]
     if differ:
         raise InputError(f"cannot resume {path}: it is a run with other settings ({'; '.join(differ)}); give "
                          "another --out, or the same settings")
@@ -514,6 +519,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "seed7, joined by +")
     p.add_argument("--sensor", choices=("cameras", "surface"), default=d.sensor,
                    help="how the policy sees the object: depth cameras, or the privileged surface sample")
+    p.add_argument("--full-motion", action="store_true",
+                   help="spins by an angle run their full motion instead of stopping at the angle (as plans execute "
+                        "them, and as the files trained before the stop were)")
     p.add_argument("--steps", type=int, default=d.steps, help="primitives to execute (default: %(default)s)")
     p.add_argument("--workers", type=int, default=d.workers,
                    help="rollout workers (processes, or Ray actors with --backend ray); 0 = in-process")
@@ -560,7 +568,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     cli_logging()
     cfg = TrainConfig(
-        primitive=args.primitive, objects=args.objects, sensor=args.sensor,
+        primitive=args.primitive, objects=args.objects, sensor=args.sensor, full_motion=args.full_motion,
         steps=args.steps, workers=args.workers, backend=args.backend,
         ray_address=args.ray_address, seed=args.seed,
         out=args.out or f"runs/{args.primitive}", max_minutes=args.max_minutes, batch_size=args.batch_size,
