@@ -153,6 +153,9 @@ class FrameSearch:
     skill reports this search's own calibrated rating of the option it picks as its success probability, and
     no searched success model (:func:`primitives.skills.load_skill`), where that was chosen on validation objects
     (push's search for camera clouds: ``primitives/weights/RECORD.md``); ``False``: a searched model where one ships.
+    ``ranker_platt``: ``(a, b)`` of ``sigmoid(a logit(q) + b)`` on the ranker's score ``q`` of the option it picks
+    (:func:`primitives.training.ranker.calibrate`); where set, a search with a ranker scores its pick by that
+    calibrated score instead of the success model's rating (:meth:`choose`, :meth:`calibrate`); ``None``: the rating.
     """
 
     turns: int = 1
@@ -165,6 +168,7 @@ class FrameSearch:
     reports_rating: bool = False
     ranker_file: str = ""
     ranker: OptionRanker | None = field(default=None, compare=False, repr=False)
+    ranker_platt: tuple[float, float] | None = None
 
     def __post_init__(self):
         free_frames("spin", None, self.turns, self.mirror)  # checks turns
@@ -172,7 +176,7 @@ class FrameSearch:
             raise InputError("a FrameSearch names a ranker file exactly when it carries a ranker")
         if not is_whole(self.stand_ins) or self.stand_ins < 0 or (self.stand_ins and self.stand_ins % self.turns):
             raise InputError(f"stand_ins must be 0 or a whole multiple of turns ({self.turns}), got {self.stand_ins!r}")
-        for ab in (self.platt, self.platt_unparameterised, self.platt_stand_ins):
+        for ab in (self.platt, self.platt_unparameterised, self.platt_stand_ins, self.ranker_platt or (1.0, 0.0)):
             if len(ab) != 2 or not all(math.isfinite(v) for v in ab):
                 raise InputError(f"a FrameSearch Platt scaling must be two finite numbers, got {ab!r}")
 
@@ -182,6 +186,12 @@ class FrameSearch:
     def tries_stand_ins(self, params: dict | None) -> bool:
         """Whether this search tries stand-in requests for ``params`` (the seed's objective, with ``stand_ins``)."""
         return params is None and self.stand_ins > 0
+
+    @property
+    def reports_ranking(self) -> bool:
+        """Whether this search scores the option it picks by its ranker's calibrated score (``ranker_platt`` set and
+        a ranker carried; the ranker then picks for every request, :meth:`ranks`)."""
+        return self.ranker is not None and self.ranker_platt is not None
 
     def ranks(self, params: dict | None) -> bool:
         """Whether this search's ranker picks the option for ``params``: wherever the search has a ranker, for the
@@ -249,10 +259,13 @@ class FrameSearch:
         kind, is highest (module docstring), and that calibrated rating.
 
         ``ranking`` (:meth:`rank`, split as ``ratings``): act in the frame it ranks highest instead; the score is
-        still that frame's rating, raw for one option or calibrated for its kind among several."""
+        still that frame's rating, raw for one option or calibrated for its kind among several, or with
+        ``ranker_platt`` the ranker's own score of it (raw: :meth:`calibrate` scales it)."""
         if ranking is not None:
             k = int(np.argmax([q.max() for q in ranking]))
             j = int(np.argmax(ranking[k]))
+            if self.reports_ranking:
+                return k, j, float(ranking[k][j])
             p = float(ratings[k][j])
             return k, j, p if len(options) == 1 else float(self.calibrate_kind(p, options[k][0].params is not None))
         best = [int(np.argmax(q)) for q in ratings]
@@ -310,7 +323,11 @@ class FrameSearch:
 
     def calibrate(self, p: np.ndarray | float, parameterised: np.ndarray | bool = True) -> np.ndarray:
         """The calibrated probability of the scores ``p`` (:meth:`select`) of requests with (or without) a
-        parameter; ``parameterised`` is one flag for all, or one per score."""
+        parameter; ``parameterised`` is one flag for all, or one per score. Where the search scores its pick by the
+        ranker (:attr:`reports_ranking`), every score is the ranker's, scaled by ``ranker_platt``."""
+        if self.reports_ranking:
+            a, b = self.ranker_platt
+            return expit(a * rating_logit(p) + b)
         if not self.stand_ins:
             return self.calibrate_kind(p, parameterised)
         a, b = self.platt_stand_ins
@@ -324,6 +341,10 @@ class FrameSearch:
         del d["ranker"], d["ranker_file"]
         if not self.reports_rating:  # written only where set, as files before it had no such key
             del d["reports_rating"]
+        if self.ranker_platt is None:
+            del d["ranker_platt"]
+        else:
+            d["ranker_platt"] = list(self.ranker_platt)
         if self.ranker_file:
             d["ranker"] = self.ranker_file
         Path(path).write_text(json.dumps(d, indent=2) + "\n")
@@ -338,7 +359,8 @@ class FrameSearch:
             search = cls(int(d["turns"]), bool(d["mirror"]), tuple(float(v) for v in d["platt"]),
                          tuple(float(v) for v in d.get("platt_unparameterised", (1.0, 0.0))), d.get("info", {}),
                          int(d.get("stand_ins", 0)), tuple(float(v) for v in d.get("platt_stand_ins", (1.0, 0.0))),
-                         reports_rating=_flag(d.get("reports_rating", False)))
+                         reports_rating=_flag(d.get("reports_rating", False)),
+                         ranker_platt=(tuple(float(v) for v in d["ranker_platt"]) if "ranker_platt" in d else None))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise InputError(f"frame search file {path} is unreadable ({type(exc).__name__}: {exc})") from exc
         if not ranker_file or not ranked:

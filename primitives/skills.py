@@ -195,7 +195,17 @@ class Skill:
         """The searched success model (rates the frame-searched skill from the goal frame), or ``None``: the
         skill acts in the goal frame, none was given, or its search reports its own rating
         (:attr:`primitives.frames.FrameSearch.reports_rating`)."""
-        if self.frame_search is None or self.frame_search.reports_rating or self._searched_weights is None:
+        if self.frame_search is None or self.frame_search.reports_rating:
+            return None
+        return self._obs_rater()
+
+    def _obs_rater(self) -> SuccessModel | None:
+        """What rates an observation alone (:meth:`success_probability_obs`): the searched success model where one was
+        given, also where the search reports its ranker's score from a simulator
+        (:attr:`primitives.frames.FrameSearch.reports_ranking`: that needs the simulator, whose object and resting
+        state its stand-in requests need); ``None`` where there is none or the search reports its own rating."""
+        search = self.frame_search
+        if search is None or self._searched_weights is None or (search.reports_rating and not search.reports_ranking):
             return None
         if self._searched is None:
             self._searched = SuccessModel(self.model, load_success_net(self.name, self._searched_weights))
@@ -219,13 +229,14 @@ class Skill:
         (:func:`primitives.training.env.observe_cloud`), all with a parameter or all without; with a frame search, the
         searched success model's answer, or without one the calibrated rating of the best free frame (for the
         seed's objective a lower bound where the search has stand-ins: rating those needs the object and its
-        resting state, which an observation does not carry; :meth:`success_probability` rates them).
+        resting state, which an observation does not carry; :meth:`success_probability` rates them). Where the search
+        reports its ranker's score (spin with camera clouds), an observation is still rated by the searched model.
         ``sensor``: the sensor whose clouds the observations were built from (default: the policy's)."""
         rated = self.ratings(sensor)
         if rated is not self:
             return rated.success_probability_obs(obs, parameterised)
-        if self.searched_model is not None:
-            return self.searched_model.predict(obs)
+        if self._obs_rater() is not None:
+            return self._obs_rater().predict(obs)
         frames = self.frames({} if parameterised else None)
         if len(frames) == 1:
             return self.success_model.predict(obs)
@@ -242,7 +253,7 @@ class Skill:
         rated = self.ratings(sensor)
         if rated is not self:
             return rated.success_spread_obs(obs, parameterised)
-        model = self.searched_model if self.searched_model is not None else self.success_model
+        model = self._obs_rater() or self.success_model
         return model.spread(obs)
 
 

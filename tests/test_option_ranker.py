@@ -1,5 +1,7 @@
 """The option ranker: its features, its file, and a frame search that acts on its ranking."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -170,6 +172,9 @@ def test_the_shipped_spin_ranks_its_options_with_camera_clouds_only():
     cameras = spin.ratings("cameras")
     assert spin.rated_sensors == ("surface", "cameras") and spin.frame_search.ranker is None
     assert cameras.frame_search.ranks(None) and cameras.frame_search.ranks({"angle": 0.4})
+    # with camera clouds it reports its ranker's calibrated score (chosen on validation objects, RECORD.md)
+    assert cameras.frame_search.reports_ranking and cameras.searched_model is None
+    assert not spin.frame_search.reports_rating
     assert cameras._success_weights == weights_file.SHIPPED_DIR / "spin_success.pt"  # the policy's own
     assert (cameras.frame_search.turns, cameras.frame_search.platt) == (spin.frame_search.turns,
                                                                        spin.frame_search.platt)
@@ -188,3 +193,39 @@ def test_the_shipped_spin_ranks_its_options_with_camera_clouds_only():
                               decide=cameras.success_model.rate_and_decide)
     assert np.allclose(chosen.obs, wanted.obs) and chosen.acted_as == wanted.acted_as
     assert cameras.observe(sim, None).params is None  # the skill's own call goes through the ranked search
+
+
+def test_a_search_with_ranker_platt_scores_its_pick_by_the_rankers_calibrated_score(tmp_path):
+    """With ``ranker_platt`` the score of the pick is the ranker's own (raw from choose, scaled by calibrate, for
+    every kind of request); the file keeps it; a search without it, or without its ranker, scores by the ratings."""
+    from scipy.special import expit, logit
+
+    sim = ap.Simulator(ap.load_object("cube"), seed=0, sensor="surface")
+    sim.reset()
+    policy = load_policy(None, "spin")
+
+    def rating(obs):
+        return np.linspace(0.8, 0.3, len(obs))
+
+    def decide(obs):
+        return rating(obs), decision_features(policy, torch.from_numpy(obs))[2].numpy()
+
+    save_ranker(tmp_path / "spin_ranker.pt", OptionRanker(8), "spin", "cameras", {})
+    ranked = FrameSearch(6, False, ranker_file="spin_ranker.pt", ranker=_Pick(4))
+    reporting = replace(ranked, ranker_platt=(0.5, 0.2))
+    assert reporting.reports_ranking and not ranked.reports_ranking
+    for params in (None, {"angle": 0.5}):
+        seen = skill_observation(sim, "spin", params, 64)
+        chosen, q = reporting.select("spin", seen, rating, sim, decide=decide)
+        same, p = ranked.select("spin", seen, rating, sim, decide=decide)
+        assert np.allclose(chosen.A_frame_world, same.A_frame_world)  # the ranker picks as before
+        assert q == pytest.approx(0.9) and p == pytest.approx(np.linspace(0.8, 0.3, 6)[4])  # _Pick's score, the rating
+        assert float(reporting.calibrate(q, params is not None)) == pytest.approx(expit(0.5 * logit(0.9) + 0.2))
+    reporting.save(tmp_path / "spin_frames.json")
+    back = FrameSearch.load(tmp_path / "spin_frames.json")
+    assert back.ranker_platt == (0.5, 0.2) and back.reports_ranking
+    assert not FrameSearch.load(tmp_path / "spin_frames.json", ranked=False).reports_ranking
+    ranked.save(tmp_path / "plain.json")
+    assert "ranker_platt" not in (tmp_path / "plain.json").read_text()
+    with pytest.raises(InputError, match="Platt"):
+        FrameSearch(6, False, ranker_platt=(float("nan"), 0.0))

@@ -85,3 +85,22 @@ def test_the_command_refuses_held_out_objects_and_empty_folders(tmp_path, capsys
     assert json.loads(capsys.readouterr().out)["options"] == 24
     assert main(["fit", "spin", str(out), "--out", str(tmp_path / "r0.pt"), "--members", "0"]) == 2
     assert "--members" in capsys.readouterr().err and not (tmp_path / "r0.pt").exists()
+
+
+def test_calibrate_writes_the_search_reporting_its_rankers_scaled_score_beside_a_copy_of_its_ranker(tmp_path, capsys):
+    """``calibrate``: frame-searched rollouts of training objects, the ranker's raw score of each pick, a Platt scaling
+    of them; the search written with ``ranker_platt`` and ``reports_rating`` and its ranker beside it, ready to load.
+    A search without a ranker, held-out objects or no rollouts are refused before anything is written."""
+    assert main(["calibrate", "spin", "--rollouts", "8", "--seed", "3", "--out", str(tmp_path / "k"), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    search = FrameSearch.load(tmp_path / "k" / "spin_frames.json")
+    shipped = load_frame_search("spin", "shipped", "cameras")
+    assert search.reports_rating and search.reports_ranking and search.ranker_file == "spin_ranker.pt"
+    assert (search.turns, search.mirror, search.platt) == (shipped.turns, shipped.mirror, shipped.platt)
+    assert search.info["ranker_calibration"] == info and info["rollouts"] == 8
+    assert info["command"] == "python -m primitives.training.ranker calibrate spin --rollouts 8 --seed 3"
+    assert 0.0 <= info["success_rate"] <= 1.0 and np.isfinite(search.ranker_platt).all()
+    for bad, says in ((["roll"], "no option ranker"), (["spin", "--objects", "housekeep:unseen"], "held out"),
+                      (["spin", "--rollouts", "0"], "--rollouts")):
+        assert main(["calibrate", *bad, "--out", str(tmp_path / "no")]) == 2
+        assert says in capsys.readouterr().err and not (tmp_path / "no").exists()

@@ -19,6 +19,7 @@ from primitives import skills as skills_module
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
 from primitives.params import as_params
+from primitives.success_model import SuccessModel, load_success_net
 from primitives.training.env import skill_observation
 
 
@@ -309,6 +310,33 @@ def test_a_sensor_search_that_reports_its_own_rating_rates_without_a_searched_mo
     assert reported != pytest.approx(float(with_model.searched_model.predict(seen.obs)), abs=1e-3)
     shipped = load_skill("push").ratings("cameras")  # as shipped: chosen on validation objects (RECORD.md)
     assert shipped.frame_search.reports_rating and shipped.searched_model is None
+
+
+def test_a_search_that_reports_its_rankers_score_rates_a_simulator_by_it_and_an_observation_by_the_searched_model(
+        tmp_path, cube):
+    _copy_skill_files("spin", tmp_path)
+    shutil.copyfile(skills_module.WEIGHTS_DIR / "cameras" / "spin_ranker.pt", tmp_path / "cameras" / "spin_ranker.pt")
+    frames = tmp_path / "cameras" / "spin_frames.json"
+    replace(FrameSearch.load(frames), reports_rating=True, ranker_platt=(0.8, 0.3)).save(frames)
+    cameras = load_skill("spin", weights_dir=tmp_path).ratings("cameras")
+    assert cameras.frame_search.reports_ranking and cameras.searched_model is None
+
+    def scanned():  # the same start and the same camera noise draws each time
+        sim = ap.Simulator(cube, seed=3)
+        sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.4)
+        return sim
+
+    search, model = cameras.frame_search, cameras.success_model
+    for params in (None, as_params("spin", {"angle": 0.5})):
+        sim = scanned()
+        seen = skill_observation(sim, "spin", params, cameras.n_points)
+        q = search.select("spin", seen, model.predict, sim, decide=model.rate_and_decide)[1]
+        assert 0.0 < q < 1.0
+        assert cameras.success_probability(scanned(), params) == pytest.approx(float(search.calibrate(q)), abs=1e-6)
+        # an observation alone (a planner's predicted cloud) is rated by the searched model
+        searched = SuccessModel(cameras.model, load_success_net("spin", frames.with_name("spin_success_searched.pt")))
+        assert np.allclose(cameras.success_probability_obs(seen.obs[None], params is not None),
+                           searched.predict(seen.obs[None]), atol=1e-6)
 
 
 def test_a_sensor_skill_of_another_name_or_with_sensors_of_its_own_is_refused():

@@ -4,6 +4,7 @@
     python -m primitives.training.ranker collect spin --starts 800 --params random --out runs/spin_opts_random
     python -m primitives.training.ranker fit spin runs/spin_opts_none runs/spin_opts_random --out runs/spin_ranker.pt
     python -m primitives.training.ranker attach spin --ranker runs/spin_ranker.pt --out candidates/spin_ranked
+    python -m primitives.training.ranker calibrate spin --rollouts 2400 --workers 2 --out candidates/spin_rank_reported
 
 **collect** draws stable starts of training objects (``--objects``, never held-out ones) and, for each, executes
 the policy in *every* option the frame search rates (each free frame of the request and of each stand-in request,
@@ -24,6 +25,14 @@ The training is a few minutes of one core; nothing of it is checkpointed.
 **attach** writes a frame search that acts on a ranker: the shipped frame search for ``--sensor`` (or ``--frames``)
 with the ranker's file named in it, both into the folder ``--out`` (``{skill}_frames.json``, ``{skill}_ranker.pt``),
 ready for ``--frames`` of the evaluation commands or for ``weights/{sensor}/``.
+
+**calibrate** makes a ranked frame search report its ranker's score of the option it picks as the skill's success
+probability: it collects ``--rollouts`` frame-searched rollouts of training objects with the search (``--frames``,
+default the shipped one for ``--sensor``), records the ranker's raw score of each pick, fits the Platt scaling
+``ranker_platt`` of those scores to the outcomes (:attr:`primitives.frames.FrameSearch.ranker_platt`), and writes the
+search with it and ``reports_rating`` set (and its ranker) into ``--out``, as **attach** does. The ranker reads the
+policy's decision in every option, so it tells one start's options apart where a searched model, which sees the goal
+frame alone, cannot. A few minutes of two cores; nothing of it is checkpointed.
 """
 
 from __future__ import annotations
@@ -40,6 +49,7 @@ import torch
 from torch import nn
 from tqdm import tqdm
 
+from affordplan.checks import is_whole
 from affordplan.errors import InputError
 from affordplan.log import cli_logging, one_line_errors
 from affordplan.sim.sensor import SENSORS
@@ -56,7 +66,16 @@ from primitives.option_ranker import (
 from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.evaluate import load_policy
 from primitives.training.options import execute_every_option
-from primitives.training.success import SuccessModel, auroc, load_success_net
+from primitives.training.success import (
+    SuccessModel,
+    auroc,
+    collect_frame_search,
+    collect_parallel,
+    fit_frame_calibration,
+    load_success_net,
+    metrics,
+)
+from primitives.weights_file import rating_path
 
 COLUMNS = ("start", "object", "decision", "rating", "request", "parameterised", "stand_in", "extents", "success",
            "chosen")
@@ -254,10 +273,51 @@ def attach(skill: str, ranker: str | Path, out: str | Path, frames: str = "shipp
     acting on ``ranker`` into the folder ``out`` (module docstring); returns the frames file written."""
     load_ranker(ranker, skill)  # refuses a file that is not a ranker for skill before anything is written
     search = load_frame_search(skill, frames, sensor, ranked=False)  # the ranker it names, if any, is replaced
+    return _write_search(skill, search, Path(ranker), out)
+
+
+def calibrate(skill: str, out: str | Path, rollouts: int = 2400, objects: str = "train+housekeep:training",
+              seed: int = 0, workers: int = 1, frames: str = "shipped", sensor: str = "cameras",
+              progress: bool = True) -> tuple[Path, dict]:
+    """Write ``frames`` (``"shipped"``: the shipped frame search for ``sensor``'s clouds, or a frames.json path; it
+    must carry a ranker) reporting its ranker's calibrated score into the folder ``out`` (module docstring); returns
+    the frames file written and what the calibration measured (also in the file's ``info["ranker_calibration"]``)."""
+    if not (is_whole(rollouts) and rollouts >= 1 and is_whole(workers) and workers >= 1):
+        raise InputError(f"--rollouts and --workers must be positive whole numbers, got {rollouts!r} and {workers!r}")
+    check_objects(objects, fitting=True)
+    search = load_frame_search(skill, frames, sensor)
+    if search.ranker is None:
+        raise InputError(f"{skill}'s frame search {frames!r} ({sensor}) has no option ranker to calibrate")
+    t0 = time.perf_counter()
+    raw = replace(search, ranker_platt=(1.0, 0.0))  # scores each pick by the ranker's raw score
+    model = SuccessModel(load_policy(None, skill, sensor=sensor), load_success_net(skill, None, sensor=sensor))
+    parts = collect_parallel(collect_frame_search, (model, skill), rollouts, seed, workers, progress=progress,
+                             search=raw, split=objects, sensor=sensor)
+    score = np.concatenate([q for q, _ in parts])
+    success = np.concatenate([data.success for _, data in parts])
+    a, b = fit_frame_calibration(score, success)
+    calibrated = replace(search, ranker_platt=(a, b), reports_rating=True)
+    info = dict(rollouts=rollouts, objects=objects, seed=seed, workers=workers, sensor=sensor,
+                success_rate=float(success.mean()), raw=metrics(score, success),
+                calibrated=metrics(calibrated.calibrate(score), success),
+                minutes=(time.perf_counter() - t0) / 60,
+                command=f"python -m primitives.training.ranker calibrate {skill} --rollouts {rollouts} --seed {seed}"
+                        + (f" --workers {workers}" if workers > 1 else "")
+                        + (f" --objects {objects}" if objects != "train+housekeep:training" else "")
+                        + (f" --frames {frames}" if frames != "shipped" else "")
+                        + (f" --sensor {sensor}" if sensor != "cameras" else ""))
+    calibrated = replace(calibrated, info=dict(search.info, ranker_calibration=info))
+    beside = rating_path(skill, "frames", sensor) if frames == "shipped" else Path(frames)  # where its ranker is
+    return _write_search(skill, calibrated, beside.parent / search.ranker_file, out), info
+
+
+def _write_search(skill: str, search: FrameSearch, ranker: Path, out: str | Path) -> Path:
+    """Write ``search`` into the folder ``out`` as ``{skill}_frames.json``, acting on a copy of the ranker file
+    ``ranker`` beside it (``{skill}_ranker.pt``); returns the frames file written."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     name = f"{skill}_ranker.pt"
-    if Path(ranker).resolve() != (out / name).resolve():
+    if ranker.resolve() != (out / name).resolve():
         shutil.copyfile(ranker, out / name)
     path = out / f"{skill}_frames.json"
     replace(search, ranker_file=name, ranker=load_ranker(out / name, skill)).save(path)
@@ -298,6 +358,18 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument("--sensor", choices=SENSORS, default="cameras",
                    help="whose shipped frame search (default: cameras)")
     a.add_argument("--out", required=True, help="folder to write {skill}_frames.json and {skill}_ranker.pt into")
+    k = sub.add_parser("calibrate", help="make a ranked frame search report its ranker's calibrated score")
+    k.add_argument("skill", choices=PRIMITIVES)
+    k.add_argument("--rollouts", type=int, default=2400, help="frame-searched rollouts (default: 2400)")
+    k.add_argument("--objects", default="train+housekeep:training",
+                   help="training objects (default: train+housekeep:training)")
+    k.add_argument("--seed", type=int, default=0)
+    k.add_argument("--workers", type=int, default=1, help="processes collecting the rollouts (default: 1)")
+    k.add_argument("--frames", default="shipped", help="the ranked frame search (default: the shipped one)")
+    k.add_argument("--sensor", choices=SENSORS, default="cameras",
+                   help="whose shipped frame search, and the clouds seen (default: cameras)")
+    k.add_argument("--out", required=True, help="folder to write {skill}_frames.json and {skill}_ranker.pt into")
+    k.add_argument("--json", action="store_true")
     return p
 
 
@@ -314,6 +386,17 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.command == "attach":
         print(f"wrote {attach(args.skill, args.ranker, args.out, args.frames, args.sensor)}")
+        return 0
+    if args.command == "calibrate":
+        path, info = calibrate(args.skill, args.out, args.rollouts, args.objects, args.seed, args.workers, args.frames,
+                               args.sensor, progress=not args.json)
+        if args.json:
+            print(json.dumps(info, indent=2))
+        else:
+            c, r = info["calibrated"], info["raw"]
+            print(f"wrote {path}: {info['rollouts']} rollouts, success {info['success_rate']:.3f}; the ranker's "
+                  f"score of its pick, raw ECE {r['ece']:.3f}, calibrated ECE {c['ece']:.3f}, Brier {c['brier']:.3f}, "
+                  f"AUROC {c['auroc']:.3f}")
         return 0
     info = fit(args.skill, args.folders, args.out, args.seed, args.epochs, args.width, args.members,
                refit=args.refit, progress=not args.json)
