@@ -235,8 +235,9 @@ class Skill:
         rated = self.ratings(sensor)
         if rated is not self:
             return rated.success_probability_obs(obs, parameterised)
-        if self._obs_rater() is not None:
-            return self._obs_rater().predict(obs)
+        rater = self._obs_rater()
+        if rater is not None:
+            return rater.predict(obs)
         frames = self.frames({} if parameterised else None)
         if len(frames) == 1:
             return self.success_model.predict(obs)
