@@ -19,7 +19,7 @@ class IdealSkill:
     def __init__(self, name: str, fail=lambda params, state: False):
         self.name, self.fail, self.calls = name, fail, []
 
-    def execute(self, sim, params, stop_at_angle=True):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         T0 = sim.object_pose()
         state = sim.obj.classify(T0)
         self.calls.append((state, dict(params)))

@@ -27,7 +27,7 @@ class _Skill:
         self.calls.append((state, sim.obj.resting_states[state].yaw_of(T[:3, :3]), dict(params)))
         return self.p
 
-    def execute(self, sim, params):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         self.executed += 1
         return type("Outcome", (), {"success": self.executed % 2 == 0})()
 

@@ -53,7 +53,7 @@ class RollsFailNear(IdealSkill):
         super().__init__("roll")
         self.xy, self.where = xy, []
 
-    def execute(self, sim, params, stop_at_angle=True):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         T0 = sim.object_pose()
         self.where.append((float(T0[0, 3]), float(T0[1, 3])))
         self.fail = lambda p, state: math.hypot(T0[0, 3] - self.xy[0], T0[1, 3] - self.xy[1]) < 0.03
@@ -86,7 +86,7 @@ class WhereIdeal(IdealSkill):
         super().__init__(name, fail)
         self.where = []
 
-    def execute(self, sim, params, stop_at_angle=True):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         self.where.append(tuple(np.round(sim.object_pose()[:2, 3], 4)))
         return super().execute(sim, params)
 
@@ -277,7 +277,7 @@ def test_on_primitive_is_told_each_primitive_once_in_order_a_push_of_several_str
 class HalfSpin(IdealSkill):
     """A spin that turns the object half the asked angle (a real policy's turn follows its ask loosely)."""
 
-    def execute(self, sim, params, stop_at_angle=True):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         return super().execute(sim, {"angle": 0.5 * params["angle"]})
 
 
@@ -310,7 +310,7 @@ def test_a_skill_named_in_sensors_acts_on_that_sensors_clouds_and_the_others_on_
     seen: list[tuple[str, str]] = []
 
     class Looking(IdealSkill):
-        def execute(self, sim, params, stop_at_angle=True):
+        def execute(self, sim, params, stop_at_angle=True, steer=True):
             seen.append((self.name, sim.sensor))
             return super().execute(sim, params)
 

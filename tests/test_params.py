@@ -237,6 +237,32 @@ def test_motion_stop_lets_other_calls_run_their_full_motion(skill, asked):
     assert params.motion_stop(skill, asked, np.eye(4)) is None
 
 
+def test_motion_steer_turns_a_push_against_the_objects_turn_about_the_vertical():
+    T0 = make_pose(rot_z(0.3), (0.5, 0.0, 0.04))
+    steer = params.motion_steer("push", None, T0)
+    step = np.array([0.001, 0.0, -0.0002])
+    assert np.allclose(steer(T0, step.copy()), step)  # no turn, no bend
+    turned = make_pose(rot_z(0.3 + 0.1), (0.52, 0.01, 0.04))
+    bent = steer(turned, step.copy())
+    assert bent[2] == step[2] and np.linalg.norm(bent[:2]) == pytest.approx(np.linalg.norm(step[:2]))
+    assert math.atan2(bent[1], bent[0]) == pytest.approx(params.PUSH_STEER_GAIN * 0.1)  # the way it turned
+    far = steer(make_pose(rot_z(0.3 - 1.0), (0.5, 0.0, 0.04)), step.copy())
+    assert math.atan2(far[1], far[0]) == pytest.approx(-params.PUSH_STEER_MAX)
+    assert callable(params.motion_steer("push", {"direction": 1.0}, T0))
+
+
+@pytest.mark.parametrize("skill, asked", [("spin", None), ("spin", {"angle": 0.4}), ("roll", None)])
+def test_motion_steer_lets_spins_and_rolls_run_straight(skill, asked):
+    assert params.motion_steer(skill, asked, np.eye(4)) is None
+
+
+def test_motion_steer_refuses_bad_input():
+    with pytest.raises(InputError):
+        params.motion_steer("push", {"angle": 0.4}, np.eye(4))
+    with pytest.raises(InputError):
+        params.motion_steer("push", None, np.eye(3))
+
+
 def test_motion_stop_refuses_bad_input():
     with pytest.raises(InputError):
         params.motion_stop("spin", {"angle": 3.0}, np.eye(4))

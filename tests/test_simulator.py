@@ -217,6 +217,35 @@ def test_a_motion_ends_where_until_holds_and_the_object_stops_turning_there(lunc
     assert abs(turns[-math.radians(15.0)] + 15.0) <= 3.0
 
 
+def test_a_push_steered_against_the_turn_turns_the_box_less_and_still_moves_it(lunch_box):
+    """The corner push above turns the box about 32 deg; steered (primitives.params.motion_steer) it turns about
+    8 deg and still travels 5 cm; a steer that keeps every step moves the box exactly as no steer does."""
+    hx, hy, _ = lunch_box.mesh.extents / 2
+    moves = {}
+    for how in ("straight", "identity", "steered"):
+        sim = ap.Simulator(lunch_box)
+        T0 = sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+        steer = {"straight": None, "identity": lambda T, step: step,
+                 "steered": params.motion_steer("push", None, T0)}[how]
+        out = sim.execute(T0[:3, 3] + np.array([-hx, 0.8 * hy, 0.0]), (1.0, 0.0, 0.0), steer=steer)
+        assert out.valid and out.approach_ok and not out.stopped
+        moves[how] = rewards.motion(out.pose_before, out.pose_after)
+    assert np.allclose(moves["identity"].p, moves["straight"].p, atol=1e-4)
+    assert moves["straight"].theta_deg > 25.0
+    assert moves["steered"].theta_deg < min(12.0, moves["straight"].theta_deg / 3.0)
+    assert np.linalg.norm(moves["steered"].p) >= 0.05
+
+
+def test_steer_must_be_a_function_giving_a_step(cube):
+    sim = ap.Simulator(cube)
+    T0 = sim.reset()
+    with pytest.raises(InputError, match="steer"):
+        sim.execute(T0[:3, 3], (1.0, 0.0, 0.0), steer="left")
+    sim.reset()
+    with pytest.raises(InputError, match="steer"):
+        sim.execute(T0[:3, 3] + np.array([-0.05, 0, 0]), (1.0, 0.0, 0.0), steer=lambda T, step: "left")
+
+
 def test_until_must_be_callable(cube):
     sim = ap.Simulator(cube)
     T0 = sim.reset()

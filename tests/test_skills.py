@@ -31,7 +31,7 @@ class _ReachLimited(ap.Simulator):
         self.refuse = refuse
         self.asked: list[np.ndarray] = []
 
-    def execute(self, contact, motion, normal=None, until=None):
+    def execute(self, contact, motion, normal=None, until=None, steer=None):
         self.asked.append(np.asarray(contact, dtype=float))
         if len(self.asked) <= self.refuse:
             raise ReachabilityError("the arm cannot reach this contact (test)")
@@ -72,7 +72,7 @@ class _DescentBlocked(ap.Simulator):
         self.checked.append(np.asarray(contact, dtype=float))
         return len(self.checked) > self.block
 
-    def execute(self, contact, motion, normal=None, until=None):
+    def execute(self, contact, motion, normal=None, until=None, steer=None):
         self.executed.append(np.asarray(contact, dtype=float))
         return super().execute(contact, motion, normal=normal)
 
@@ -417,15 +417,17 @@ def test_a_sensor_folder_policy_serves_that_sensor_even_where_the_main_policy_wa
 
 
 class _Recording(ap.Simulator):
-    """A finger simulator that records the ``until`` each primitive is given."""
+    """A finger simulator that records the ``until`` and ``steer`` each primitive is given."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self.untils: list = []
+        self.steers: list = []
 
-    def execute(self, contact, motion, normal=None, until=None):
+    def execute(self, contact, motion, normal=None, until=None, steer=None):
         self.untils.append(until)
-        return super().execute(contact, motion, normal=normal, until=until)
+        self.steers.append(steer)
+        return super().execute(contact, motion, normal=normal, until=until, steer=steer)
 
 
 def test_a_spin_by_an_angle_stops_at_it_unless_told_to_run_its_full_motion(lunch_box):
@@ -439,3 +441,14 @@ def test_a_spin_by_an_angle_stops_at_it_unless_told_to_run_its_full_motion(lunch
     sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
     spin.execute(sim, None)  # the seed's objective: no angle to stop at
     assert callable(sim.untils[0]) and sim.untils[1] is None and sim.untils[2] is None
+    assert sim.steers == [None, None, None]  # spins run straight
+
+
+def test_a_push_steers_against_the_turn_unless_told_to_push_straight(cube):
+    push = load_skill("push")
+    sim = _Recording(cube, seed=0)
+    for asked, steer in ((None, True), ({"direction": 0.3}, True), (None, False)):
+        sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
+        push.execute(sim, asked, steer=steer)
+    assert callable(sim.steers[0]) and callable(sim.steers[1]) and sim.steers[2] is None
+    assert sim.untils == [None, None, None]  # a push has no angle to stop at

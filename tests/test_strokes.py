@@ -22,7 +22,7 @@ class Veering(IdealSkill):
         super().__init__("push")
         self.veer = veer
 
-    def execute(self, sim, params):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         T0 = sim.object_pose()
         self.calls.append((sim.obj.classify(T0), dict(params)))
         a = params["direction"] + self.veer
@@ -72,7 +72,7 @@ class Turning(IdealSkill):
         super().__init__("push")
         self.turn = turn
 
-    def execute(self, sim, params):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         out = super().execute(sim, params)
         T1 = out.pose_after.copy()
         T1[:3, :3] = rot_z(self.turn) @ T1[:3, :3]
@@ -88,7 +88,7 @@ def test_a_stroke_that_turns_the_object_ends_the_call(sim):
 
 def test_the_strokes_are_capped(sim):
     class Short(IdealSkill):  # each stroke moves the object 1.5 cm: progress, but far from the target
-        def execute(self, sim, params):
+        def execute(self, sim, params, stop_at_angle=True, steer=True):
             T0 = sim.object_pose()
             self.calls.append(params)
             T1 = T0.copy()
@@ -122,7 +122,7 @@ class Overturning(IdealSkill):
         super().__init__("spin")
         self.gain = gain
 
-    def execute(self, sim, params):
+    def execute(self, sim, params, stop_at_angle=True, steer=True):
         T0 = sim.object_pose()
         self.calls.append((sim.obj.classify(T0), dict(params)))
         T1 = T0.copy()
@@ -163,7 +163,7 @@ def test_a_spin_call_turns_clockwise_for_a_negative_angle(sim):
 
 def test_a_spin_that_tips_the_object_over_ends_the_call_unsuccessfully(sim, cube):
     class Tipping(IdealSkill):
-        def execute(self, sim, params):
+        def execute(self, sim, params, stop_at_angle=True, steer=True):
             T0 = sim.object_pose()
             T1 = cube.resting_states[1].pose(tuple(T0[:2, 3]), 0.0)
             sim.set_object_pose(T1, settle=False)
@@ -177,7 +177,7 @@ def test_a_stroke_that_rolls_the_object_about_a_level_axis_is_no_spin(sim, cube)
     """A can on its side rolled about its length stays in its resting state but is not spun: the call goes on."""
 
     class Rolling(IdealSkill):
-        def execute(self, sim, params):
+        def execute(self, sim, params, stop_at_angle=True, steer=True):
             T0 = sim.object_pose()
             self.calls.append((0, dict(params)))
             T1 = T0.copy()
@@ -222,7 +222,7 @@ def test_a_roll_into_another_state_ends_the_call(sim):
     first, other = roll_targets(sim.obj, 0)[:2]
 
     class Astray(IdealSkill):
-        def execute(self, sim, params):
+        def execute(self, sim, params, stop_at_angle=True, steer=True):
             return super().execute(sim, {"target": other})
 
     made = roll_to(Astray("roll"), sim, first, max_strokes=3)

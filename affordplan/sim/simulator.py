@@ -326,7 +326,8 @@ class Simulator:
         self._pusher.home()
 
     def execute(self, contact, motion, normal=None,
-                until: Callable[[np.ndarray], bool] | None = None) -> Outcome:
+                until: Callable[[np.ndarray], bool] | None = None,
+                steer: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None) -> Outcome:
         """Run one primitive: approach ``contact`` (world point, metres), then move by ``motion``.
 
         ``motion`` is (3,) in [-1, 1] (values beyond are clipped): each of the 3 control steps moves
@@ -335,10 +336,15 @@ class Simulator:
         object's world pose ``T_world_object`` (4x4) after every 20 ms of the motion; once it returns true
         the fingertip target holds at the fingertip's position, the motion ends there and the retract follows
         (``Outcome.stopped``): a spin by an angle ends where the object has turned that far
-        (:func:`primitives.params.motion_stop`).
+        (:func:`primitives.params.motion_stop`). ``steer``, when given, is called every 20 ms of the motion with
+        the object's world pose and the fingertip target's next increment ``step`` (world, metres) and returns the
+        increment to make instead: the motion's path bends where the object's pose asks it to (a push that keeps
+        the object from turning, :func:`primitives.params.motion_steer`).
         """
         if until is not None and not callable(until):
             raise InputError(f"until must be a function of the object's pose or None, got {describe(until)}")
+        if steer is not None and not callable(steer):
+            raise InputError(f"steer must be a function of the object's pose and a step or None, got {describe(steer)}")
         contact = _vector(contact, "contact")
         motion = np.clip(as_vector("motion", motion, 3), -1.0, 1.0)  # any finite motion; clipped as documented
         normal, touch, pre = self._approach_points(contact, normal)
@@ -362,6 +368,13 @@ class Simulator:
                 if result["approach_ok"]:
                     target = touch
                     for _ in range(p.motion_steps):
+                        if steer is not None:
+                            target, stop = self._steered(target, p.motion_step * motion, p.motion_step_time,
+                                                         steer, until)
+                            if stop:
+                                result["stopped"] = True
+                                break
+                            continue
                         nxt = self._clamp(target + p.motion_step * motion)
                         if self._servo(target, nxt, p.motion_step_time, track=True, until=until):
                             result["stopped"] = True
@@ -433,6 +446,26 @@ class Simulator:
                 self._pusher.command(self._pusher.tip())
                 return True
         return False
+
+    def _steered(self, start: np.ndarray, move: np.ndarray, duration: float,
+                 steer: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                 until: Callable[[np.ndarray], bool] | None) -> tuple[np.ndarray, bool]:
+        """Move the fingertip target from ``start`` by ``move`` (world, metres) over ``duration`` seconds, each 20 ms
+        increment as ``steer`` bends it from the object's pose; returns the target reached and whether ``until``
+        ended the move (the target then holds at the fingertip)."""
+        n_chunks = self._chunks(duration)
+        step = np.asarray(move, dtype=float) / n_chunks
+        target = np.array(start, dtype=float)
+        for _ in range(n_chunks):
+            bent = as_vector("steer's step", steer(self.object_pose(), step.copy()), 3)
+            target = self._clamp(target + bent)
+            self._pusher.command(target)
+            self._step(CHUNK_STEPS)
+            self._tracking.append(float(np.linalg.norm(self._pusher.tip() - target)))
+            if until is not None and until(self.object_pose()):
+                self._pusher.command(self._pusher.tip())
+                return self._pusher.tip(), True
+        return target, False
 
     def _settle(self, max_time: float, guarded: bool = True) -> None:
         p = self.protocol

@@ -53,9 +53,10 @@ class EnvConfig:
     :func:`affordplan.objects.housekeep.names`), several of these joined by ``+`` (each episode draws a group
     uniformly, then an object in it), or a tuple of catalogue names / mesh paths.
     ``sensor``: how the policy sees the object (:meth:`affordplan.Simulator.point_cloud`).
-    ``full_motion``: a spin by an angle runs its full motion instead of ending where the object has turned that far
-    (:func:`primitives.params.motion_stop`): the primitive as plans execute it, and as every file fitted before the
-    stop (2026-12-06) was collected or trained.
+    ``full_motion``: every stroke runs its commanded motion in full, open-loop as HACMan's protocol has it: a spin by
+    an angle does not end where the object has turned that far (:func:`primitives.params.motion_stop`) and a push is
+    not steered against the object's turn (:func:`primitives.params.motion_steer`). Spins run so in plans; every
+    file fitted before the spin's stop (2026-12-06) or the push's steering (2026-12-07) was collected or trained so.
     """
 
     primitive: str = "push"
@@ -233,10 +234,13 @@ class PrimitiveEnv:
         """Execute the primitive at point ``index`` with goal-frame ``motion``; the episode ends here."""
         assert self.sim is not None and self.seen is not None, "call reset() first"
         seen = self.seen
-        until = None if self.config.full_motion else skill_params.motion_stop(self.config.primitive, self.params,
-                                                                               self.sim.object_pose())
+        until = steer = None
+        if not self.config.full_motion:
+            T_world_object = self.sim.object_pose()
+            until = skill_params.motion_stop(self.config.primitive, self.params, T_world_object)
+            steer = skill_params.motion_steer(self.config.primitive, self.params, T_world_object)
         out = self.sim.execute(seen.points[index], seen.motion_to_world(motion), normal=seen.normals[index],
-                               until=until)
+                               until=until, steer=steer)
         name, obj = self.config.primitive, self.sim.obj
         reward = -rewards.loss(name, out.pose_before, out.pose_after, self.params, obj)
         success = rewards.success(name, out.pose_before, out.pose_after, self.params, obj)

@@ -240,7 +240,7 @@ def collect(skill: str, skills: Mapping[str, Skill], rollouts: int, objects: str
             skipped += 1
             continue
         p = skills[skill].success_probability(sim, params)
-        out = skills[skill].execute(sim, params, stop_at_angle=False)  # as plans execute their calls
+        out = skills[skill].execute(sim, params, stop_at_angle=False, steer=False)  # as plans execute their calls
         m = measure(obj, skill, params, out.pose_before, out.pose_after)
         row = dict(m, p=p, param=next(iter(params.values())), success=bool(out.success), valid=bool(out.valid),
                    object=names.setdefault(object_name(key), len(names)),

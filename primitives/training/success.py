@@ -624,8 +624,9 @@ def build_parser() -> argparse.ArgumentParser:
                  "(default: %(default)s)")
         sub.choices[name].add_argument(
             "--full-motion", action="store_true",
-            help="spins by an angle run their full motion instead of stopping at the angle: as plans execute them, "
-                 "and as every file fitted before the stop (2026-12-06) was collected")
+            help="every stroke runs its commanded motion open-loop: spins by an angle do not stop at the angle and "
+                 "pushes are not steered against the object's turn (as every file fitted before 2026-12-06 was "
+                 "collected; pushes until 2026-12-07)")
     for name in ("train", "frames"):
         sub.choices[name].add_argument(
             "--workers", type=int, default=1,

@@ -95,7 +95,7 @@ class TrainConfig:
     # each drawn half the time (primitives.training.env.EnvConfig.objects).
     objects: str | tuple[str, ...] = "train+housekeep:training"
     sensor: str = "cameras"  # how the policy sees the object (affordplan.Simulator.point_cloud)
-    full_motion: bool = False  # spins by an angle run their full motion (EnvConfig.full_motion), as before the stop
+    full_motion: bool = False  # strokes run open-loop, no spin stop or push steering (EnvConfig.full_motion)
     n_objects: int = 500
     p_params: float = 0.75  # share of episodes that ask for a parameter (0: the seed's objective only)
     init: str | None = None  # weights to start from (ignored on --resume)
@@ -520,8 +520,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sensor", choices=("cameras", "surface"), default=d.sensor,
                    help="how the policy sees the object: depth cameras, or the privileged surface sample")
     p.add_argument("--full-motion", action="store_true",
-                   help="spins by an angle run their full motion instead of stopping at the angle (as plans execute "
-                        "them, and as the files trained before the stop were)")
+                   help="every stroke runs its commanded motion open-loop: spins by an angle do not stop at the angle "
+                        "and pushes are not steered (as the files trained before 2026-12-06 were)")
     p.add_argument("--steps", type=int, default=d.steps, help="primitives to execute (default: %(default)s)")
     p.add_argument("--workers", type=int, default=d.workers,
                    help="rollout workers (processes, or Ray actors with --backend ray); 0 = in-process")
