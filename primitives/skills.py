@@ -55,7 +55,7 @@ from primitives import rewards
 from primitives.frames import FrameSearch, reframe_obs, shipped_frame_search  # noqa: F401 (re-exported)
 from primitives.networks import HybridActorCritic
 from primitives.observation import SkillObservation, skill_observation
-from primitives.params import SKILLS, ParamsLike, SkillName, as_params, motion_steer, motion_stop
+from primitives.params import SKILLS, ParamsLike, SkillName, as_params, motion_loop
 from primitives.policy import greedy_action, load_policy
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.weights_file import SHIPPED_DIR as WEIGHTS_DIR
@@ -158,9 +158,9 @@ class Skill:
         A spin by an angle ends its motion once the object has turned that far (:func:`primitives.params.motion_stop`);
         ``stop_at_angle=False`` runs its full motion, as plans execute spins (on the 200 validation plan tasks the
         stopping spin cost plans 9.29 -> 10.26 primitives over the tasks both reached, 153 -> 150 reached).
-        A push bends its fingertip's path against the object's turn while it runs
-        (:func:`primitives.params.motion_steer`); ``steer=False`` pushes straight along the policy's motion,
-        open-loop as HACMan's protocol has it (as plans push).
+        A push bends its fingertip's path against the object's turn while it runs and goes on until the object has
+        travelled far enough (:func:`primitives.params.motion_loop`); ``steer=False`` pushes straight along the
+        policy's motion, open-loop as HACMan's protocol has it (as plans push).
         The policy and ratings are those for ``sim``'s sensor (:meth:`ratings`).
         """
         rated = self.ratings(getattr(sim, "sensor", None))
@@ -168,8 +168,7 @@ class Skill:
             return rated.execute(sim, params, stop_at_angle, steer)
         seen = self.observe(sim, params)
         T_world_object = sim.object_pose()
-        until = motion_stop(self.name, seen.params, T_world_object) if stop_at_angle else None
-        bend = motion_steer(self.name, seen.params, T_world_object) if steer else None
+        loop = motion_loop(self.name, seen.params, T_world_object, stop_at_angle=stop_at_angle, steer=steer)
         allowed = np.ones(len(seen.points), dtype=bool)
         retries = 0
         while True:
@@ -177,7 +176,7 @@ class Skill:
             last_try = retries >= MAX_REACH_RETRIES
             try:
                 if last_try or sim.approach_clear(contact, normal):
-                    out = sim.execute(contact, motion, normal=normal, until=until, steer=bend)
+                    out = sim.execute(contact, motion, normal=normal, **loop.as_kwargs())
                     break
             except ReachabilityError:
                 if last_try:

@@ -263,6 +263,21 @@ def test_motion_steer_refuses_bad_input():
         params.motion_steer("push", None, np.eye(3))
 
 
+def test_motion_loop_closes_a_push_on_its_reach_a_spin_on_its_angle_and_leaves_rolls_open():
+    T0 = make_pose(rot_z(0.3), (0.5, 0.0, 0.04))
+    push = params.motion_loop("push", None, T0)
+    assert callable(push.steer) and push.motion_steps == params.PUSH_REACH_STEPS
+    near = make_pose(rot_z(0.3), (0.5 + 0.8 * params.PUSH_REACH, 0.0, 0.04))
+    far = make_pose(rot_z(0.3), (0.5, -params.PUSH_REACH, 0.05))  # any horizontal direction counts; height not
+    assert not push.until(near) and push.until(far)
+    assert params.motion_loop("push", None, T0, steer=False) == params.MotionLoop()
+    spin = params.motion_loop("spin", {"angle": 0.4}, T0)
+    assert callable(spin.until) and spin.steer is None and spin.motion_steps is None
+    assert params.motion_loop("spin", {"angle": 0.4}, T0, stop_at_angle=False) == params.MotionLoop()
+    assert params.motion_loop("roll", None, T0) == params.MotionLoop()
+    assert set(push.as_kwargs()) == {"until", "steer", "motion_steps"}
+
+
 def test_motion_stop_refuses_bad_input():
     with pytest.raises(InputError):
         params.motion_stop("spin", {"angle": 3.0}, np.eye(4))

@@ -18,6 +18,7 @@ from primitives import load_skill, rewards, weights_file
 from primitives import skills as skills_module
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
+from primitives import params as skill_params
 from primitives.params import as_params
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.training.env import skill_observation
@@ -31,7 +32,7 @@ class _ReachLimited(ap.Simulator):
         self.refuse = refuse
         self.asked: list[np.ndarray] = []
 
-    def execute(self, contact, motion, normal=None, until=None, steer=None):
+    def execute(self, contact, motion, normal=None, until=None, steer=None, motion_steps=None):
         self.asked.append(np.asarray(contact, dtype=float))
         if len(self.asked) <= self.refuse:
             raise ReachabilityError("the arm cannot reach this contact (test)")
@@ -72,7 +73,7 @@ class _DescentBlocked(ap.Simulator):
         self.checked.append(np.asarray(contact, dtype=float))
         return len(self.checked) > self.block
 
-    def execute(self, contact, motion, normal=None, until=None, steer=None):
+    def execute(self, contact, motion, normal=None, until=None, steer=None, motion_steps=None):
         self.executed.append(np.asarray(contact, dtype=float))
         return super().execute(contact, motion, normal=normal)
 
@@ -423,11 +424,13 @@ class _Recording(ap.Simulator):
         super().__init__(*args, **kwargs)
         self.untils: list = []
         self.steers: list = []
+        self.motion_steps: list = []
 
-    def execute(self, contact, motion, normal=None, until=None, steer=None):
+    def execute(self, contact, motion, normal=None, until=None, steer=None, motion_steps=None):
         self.untils.append(until)
         self.steers.append(steer)
-        return super().execute(contact, motion, normal=normal, until=until, steer=steer)
+        self.motion_steps.append(motion_steps)
+        return super().execute(contact, motion, normal=normal, until=until, steer=steer, motion_steps=motion_steps)
 
 
 def test_a_spin_by_an_angle_stops_at_it_unless_told_to_run_its_full_motion(lunch_box):
@@ -451,4 +454,6 @@ def test_a_push_steers_against_the_turn_unless_told_to_push_straight(cube):
         sim.reset(resting_state=0, xy=(0.5, 0.0), yaw=0.0)
         push.execute(sim, asked, steer=steer)
     assert callable(sim.steers[0]) and callable(sim.steers[1]) and sim.steers[2] is None
-    assert sim.untils == [None, None, None]  # a push has no angle to stop at
+    # a steered push goes on until the object has travelled far enough; a straight one runs the protocol's motion
+    assert callable(sim.untils[0]) and callable(sim.untils[1]) and sim.untils[2] is None
+    assert sim.motion_steps == [skill_params.PUSH_REACH_STEPS, skill_params.PUSH_REACH_STEPS, None]

@@ -93,6 +93,9 @@ class SimState:
     pusher: tuple
 
 
+MAX_MOTION_STEPS = 10  # the most control steps one call's motion may run (execute's motion_steps)
+
+
 class _Abort(Exception):
     """Internal: a guard fired; carries its reason."""
 
@@ -327,11 +330,14 @@ class Simulator:
 
     def execute(self, contact, motion, normal=None,
                 until: Callable[[np.ndarray], bool] | None = None,
-                steer: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None) -> Outcome:
+                steer: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
+                motion_steps: int | None = None) -> Outcome:
         """Run one primitive: approach ``contact`` (world point, metres), then move by ``motion``.
 
-        ``motion`` is (3,) in [-1, 1] (values beyond are clipped): each of the 3 control steps moves
-        the fingertip target by ``motion * 3 cm``. ``normal`` is the outward surface normal at the
+        ``motion`` is (3,) in [-1, 1] (values beyond are clipped): each of the protocol's control steps (3, or
+        ``motion_steps``, at most ``MAX_MOTION_STEPS``) moves the fingertip target by ``motion * 3 cm``; a call
+        that ends on ``until`` may ask for more steps than it expects to need (a push that goes on until the object
+        has travelled far enough, :func:`primitives.params.motion_loop`). ``normal`` is the outward surface normal at the
         contact; by default that of the nearest surface sample. ``until``, when given, is called with the
         object's world pose ``T_world_object`` (4x4) after every 20 ms of the motion; once it returns true
         the fingertip target holds at the fingertip's position, the motion ends there and the retract follows
@@ -345,6 +351,8 @@ class Simulator:
             raise InputError(f"until must be a function of the object's pose or None, got {describe(until)}")
         if steer is not None and not callable(steer):
             raise InputError(f"steer must be a function of the object's pose and a step or None, got {describe(steer)}")
+        n_motion = self.protocol.motion_steps if motion_steps is None else as_whole(
+            "motion_steps", motion_steps, 1, MAX_MOTION_STEPS)
         contact = _vector(contact, "contact")
         motion = np.clip(as_vector("motion", motion, 3), -1.0, 1.0)  # any finite motion; clipped as documented
         normal, touch, pre = self._approach_points(contact, normal)
@@ -367,7 +375,7 @@ class Simulator:
                 result["approach_ok"] = self._approach(pre, touch, normal, pose_before)
                 if result["approach_ok"]:
                     target = touch
-                    for _ in range(p.motion_steps):
+                    for _ in range(n_motion):
                         if steer is not None:
                             target, stop = self._steered(target, p.motion_step * motion, p.motion_step_time,
                                                          steer, until)

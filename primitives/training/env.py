@@ -55,8 +55,9 @@ class EnvConfig:
     ``sensor``: how the policy sees the object (:meth:`affordplan.Simulator.point_cloud`).
     ``full_motion``: every stroke runs its commanded motion in full, open-loop as HACMan's protocol has it: a spin by
     an angle does not end where the object has turned that far (:func:`primitives.params.motion_stop`) and a push is
-    not steered against the object's turn (:func:`primitives.params.motion_steer`). Spins run so in plans; every
-    file fitted before the spin's stop (2026-12-06) or the push's steering (2026-12-07) was collected or trained so.
+    neither steered against the object's turn nor carried on until the object has travelled far enough
+    (:func:`primitives.params.motion_loop`). Spins run so in plans; every file fitted before the spin's stop
+    (2026-12-06), the push's steering (2026-12-07) or its reach (2026-12-08) was collected or trained so.
     """
 
     primitive: str = "push"
@@ -234,13 +235,11 @@ class PrimitiveEnv:
         """Execute the primitive at point ``index`` with goal-frame ``motion``; the episode ends here."""
         assert self.sim is not None and self.seen is not None, "call reset() first"
         seen = self.seen
-        until = steer = None
+        loop = skill_params.MotionLoop()
         if not self.config.full_motion:
-            T_world_object = self.sim.object_pose()
-            until = skill_params.motion_stop(self.config.primitive, self.params, T_world_object)
-            steer = skill_params.motion_steer(self.config.primitive, self.params, T_world_object)
+            loop = skill_params.motion_loop(self.config.primitive, self.params, self.sim.object_pose())
         out = self.sim.execute(seen.points[index], seen.motion_to_world(motion), normal=seen.normals[index],
-                               until=until, steer=steer)
+                               **loop.as_kwargs())
         name, obj = self.config.primitive, self.sim.obj
         reward = -rewards.loss(name, out.pose_before, out.pose_after, self.params, obj)
         success = rewards.success(name, out.pose_before, out.pose_after, self.params, obj)
