@@ -15,10 +15,10 @@ import affordplan as ap
 from affordplan.errors import InputError, ReachabilityError
 from affordplan.sim.sensor import SENSORS
 from primitives import load_skill, rewards, weights_file
+from primitives import params as skill_params
 from primitives import skills as skills_module
 from primitives.frames import FrameSearch
 from primitives.networks import HybridActorCritic
-from primitives import params as skill_params
 from primitives.params import as_params
 from primitives.success_model import SuccessModel, load_success_net
 from primitives.training.env import skill_observation

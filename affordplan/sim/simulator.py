@@ -337,8 +337,8 @@ class Simulator:
         ``motion`` is (3,) in [-1, 1] (values beyond are clipped): each of the protocol's control steps (3, or
         ``motion_steps``, at most ``MAX_MOTION_STEPS``) moves the fingertip target by ``motion * 3 cm``; a call
         that ends on ``until`` may ask for more steps than it expects to need (a push that goes on until the object
-        has travelled far enough, :func:`primitives.params.motion_loop`). ``normal`` is the outward surface normal at the
-        contact; by default that of the nearest surface sample. ``until``, when given, is called with the
+        has travelled far enough, :func:`primitives.params.motion_loop`). ``normal`` is the outward surface normal at
+        the contact; by default that of the nearest surface sample. ``until``, when given, is called with the
         object's world pose ``T_world_object`` (4x4) after every 20 ms of the motion; once it returns true
         the fingertip target holds at the fingertip's position, the motion ends there and the retract follows
         (``Outcome.stopped``): a spin by an angle ends where the object has turned that far
