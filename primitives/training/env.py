@@ -57,7 +57,7 @@ class EnvConfig:
     an angle does not end where the object has turned that far (:func:`primitives.params.motion_stop`) and a push is
     neither steered against the object's turn nor carried on until the object has travelled far enough
     (:func:`primitives.params.motion_loop`). Spins run so in plans; every file fitted before the spin's stop
-    (2026-12-06), the push's steering (2026-12-07) or its reach (2026-12-08) was collected or trained so.
+    (2026-12-06), the push's steering or its reach (both 2026-12-07) was collected or trained so.
     """
 
     primitive: str = "push"
