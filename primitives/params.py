@@ -392,10 +392,9 @@ def motion_steer(skill: str, params: ParamsLike, T_world_object: np.ndarray
     gains 1 / 2 / 4 / 8 / 16: 0.546 / 0.604 / 0.633 / 0.629 / 0.613; with 4 on another 240 (``--seed 99``) 0.467 ->
     0.638. With that scaling refitted on steered training rollouts, the same command printed 0.617; on the 25 unseen
     household objects (``--objects housekeep:unseen --trials 24``) 0.745, against 0.562 straight (before the push
-    also ran on to its reach, :func:`motion_loop`). Of the
-    steered pushes that still fail,
-    most moved the object less than 5 cm; 15 of 240 turned 5 deg or more while travelling far enough (64
-    straight). Spins and rolls run straight.
+    also ran on to its reach, :func:`motion_loop`). Of the steered pushes that still fail, most moved the object
+    less than 5 cm; 15 of 240 turned 5 deg or more while travelling far enough (64 straight). Spins and rolls run
+    straight.
 
     Raises:
         InputError: ``params`` that ``skill`` does not take (:func:`check`), or a pose that is not a 4x4 of finite
