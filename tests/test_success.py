@@ -34,6 +34,19 @@ def _synthetic(n: int, rng: np.random.Generator) -> success.Rollouts:
                             rng.integers(0, 50, size=n), np.ones(n, bool))
 
 
+def test_a_reliability_diagram_wraps_a_long_title_and_shows_the_metrics(tmp_path):
+    rng = np.random.default_rng(0)
+    p = rng.random(200)
+    y = rng.random(200) < p
+    title = "push success model, frame search, housekeep:unseen, cameras"
+    path = tmp_path / "reliability.png"
+    heading = success.plot_reliability(p, y, path, title)
+    *lines, figures = heading.split("\n")
+    assert " ".join(lines) == title and len(lines) == 2 and all(len(line) <= 44 for line in lines)
+    assert figures.startswith(f"ECE {success.metrics(p, y)['ece']:.3f}") and figures.endswith("(n=200)")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_fit_learns_and_calibrates_on_synthetic_rollouts():
     torch.set_num_threads(1)
     rng = np.random.default_rng(0)

@@ -42,6 +42,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import textwrap
 import time
 import zipfile
 import zlib
@@ -371,8 +372,9 @@ def metrics(p: np.ndarray, y: np.ndarray) -> dict:
                 brier=brier(p, y), auroc=auroc(p, y))
 
 
-def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, title: str, bins: int = 10) -> None:
-    """Reliability diagram: measured success rate per predicted-probability bin, and the bin counts."""
+def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, title: str, bins: int = 10) -> str:
+    """Reliability diagram: measured success rate per predicted-probability bin, and the bin counts; returns the
+    title drawn (``title`` wrapped to the figure's width, then the metrics)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -388,8 +390,9 @@ def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, titl
     ax.set_ylabel("measured success rate")
     ax.set_ylim(0, 1)
     m = metrics(p, y)
-    ax.set_title(f"{title}\nECE {m['ece']:.3f}  Brier {m['brier']:.3f}  AUROC {m['auroc']:.3f}  (n={m['n']})",
-                 fontsize=9)
+    heading = (f"{textwrap.fill(title, 44)}\n"
+               f"ECE {m['ece']:.3f}  Brier {m['brier']:.3f}  AUROC {m['auroc']:.3f}  (n={m['n']})")
+    ax.set_title(heading, fontsize=9)
     ax.legend(fontsize=8, loc="upper left")
     ax2.bar(centres, count, width=1 / bins, edgecolor="black", color="#888888")
     ax2.set_xlabel("predicted P(success)")
@@ -397,6 +400,7 @@ def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, titl
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+    return heading
 
 
 # ----------------------------------------------------------------------------- training
