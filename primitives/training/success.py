@@ -372,6 +372,9 @@ def metrics(p: np.ndarray, y: np.ndarray) -> dict:
                 brier=brier(p, y), auroc=auroc(p, y))
 
 
+RELIABILITY_TITLE_CHARS = 44  # characters of a reliability diagram's title per line: what its 4.5-inch width holds
+
+
 def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, title: str, bins: int = 10) -> str:
     """Reliability diagram: measured success rate per predicted-probability bin, and the bin counts; returns the
     title drawn (``title`` wrapped to the figure's width, then the metrics)."""
@@ -390,7 +393,7 @@ def plot_reliability(p: np.ndarray, y: np.ndarray, path: str | os.PathLike, titl
     ax.set_ylabel("measured success rate")
     ax.set_ylim(0, 1)
     m = metrics(p, y)
-    heading = (f"{textwrap.fill(title, 44)}\n"
+    heading = (f"{textwrap.fill(title, RELIABILITY_TITLE_CHARS)}\n"
                f"ECE {m['ece']:.3f}  Brier {m['brier']:.3f}  AUROC {m['auroc']:.3f}  (n={m['n']})")
     ax.set_title(heading, fontsize=9)
     ax.legend(fontsize=8, loc="upper left")
