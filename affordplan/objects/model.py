@@ -26,11 +26,13 @@ import trimesh
 from affordplan.checks import as_finite
 from affordplan.errors import InputError, MeshError
 from affordplan.objects import decompose, family, housekeep, repair
+from affordplan.objects.exposed import exposed_samples
 from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states, yaw_period
 from affordplan.objects.shapes import CATALOGUE, Shape
 
 DEFAULT_SIZE = 0.05  # largest half-extent, metres
 DEFAULT_DENSITY = 400.0  # kg/m^3: household objects are partly hollow
+TOP_UP_DRAWS = 20  # uniform draws surface_samples tops its count up with before it falls back to the raw mesh
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb", ".gltf", ".off", ".dae", ".3mf")
 
 
@@ -94,26 +96,41 @@ class ObjectModel:
         return angle_to_state(self.resting_states[state], np.asarray(pose)[:3, :3])
 
     def surface_samples(self, n: int = 8192, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        """``n`` points spread over the surface and their outward unit normals, object frame.
+        """``n`` points spread over the surface the convex parts expose, and their outward unit normals, object frame.
 
-        Read-only arrays, computed once per ``(n, seed)`` and kept on the model.
+        The points are drawn on ``mesh``; those buried in the parts (a raw mesh's inner faces) are left out and
+        normals wound into the parts are reversed (:mod:`affordplan.objects.exposed`), so that every point is one
+        the simulated pusher can touch from where its normal points. Read-only arrays, computed once per
+        ``(n, seed)`` and kept on the model.
         """
         key = (int(n), int(seed))
         if key not in self._samples:
             # trimesh.sample.sample_surface_even's own steps (3n uniform samples, those closer than its radius
             # dropped), without the warning it logs when fewer than n are left: those are topped up below
-            points, face_idx = trimesh.sample.sample_surface(self.mesh, 3 * n, seed=seed)
-            points, keep = trimesh.points.remove_close(points, np.sqrt(self.mesh.area / (3 * n)))
-            points, face_idx = points[:n], face_idx[keep][:n]
-            if len(points) < n:  # fewer than n far enough apart: top up uniformly
-                extra, extra_idx = trimesh.sample.sample_surface(self.mesh, n - len(points), seed=seed)
-                points = np.vstack([points, extra])
-                face_idx = np.concatenate([face_idx, extra_idx])
-            normals = np.array(self.mesh.face_normals[face_idx])
+            points, normals = self._exposed_draw(3 * n, seed)
+            exposed = max(len(points), 1) / (3 * n)  # the share of the mesh's area the parts expose
+            points, keep = trimesh.points.remove_close(points, np.sqrt(exposed * self.mesh.area / (3 * n)))
+            points, normals = points[:n], normals[keep][:n]
+            for k in range(TOP_UP_DRAWS):  # fewer than n far enough apart: top up uniformly
+                missing = n - len(points)
+                if missing <= 0:
+                    break
+                extra, extra_normals = self._exposed_draw(int(np.ceil(missing / exposed)), seed + k)
+                points = np.vstack([points, extra[:missing]])
+                normals = np.vstack([normals, extra_normals[:missing]])
+            if len(points) < n:  # the parts expose almost none of the mesh: its own samples, as drawn
+                points, face_idx = trimesh.sample.sample_surface(self.mesh, n, seed=seed)
+                normals = np.array(self.mesh.face_normals[face_idx])
             points.setflags(write=False)
             normals.setflags(write=False)
             self._samples[key] = (points, normals)
         return self._samples[key]
+
+    def _exposed_draw(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """Up to ``n`` uniform samples of ``mesh`` that the parts expose, with their outward normals."""
+        points, face_idx = trimesh.sample.sample_surface(self.mesh, n, seed=seed)
+        keep, normals = exposed_samples(self.parts, points, self.mesh.face_normals[face_idx])
+        return points[keep], normals[keep]
 
 
 def catalogue() -> list[str]:

@@ -110,7 +110,8 @@ class Simulator:
             (a 7-DOF arm driven by mink IK; see :mod:`affordplan.sim.arm`).
         seed: seeds the point-cloud sampling and the sensor's noise; physics itself is deterministic.
         sensor: ``"cameras"`` (depth cameras, :mod:`affordplan.sim.sensor`; the default) or ``"surface"`` (the
-            privileged even sample of the true surface, for ablations only); see :meth:`point_cloud`.
+            privileged even sample of the surface the object's parts expose, for ablations only); see
+            :meth:`point_cloud`.
         workspace: where objects live; the guards allow a margin around it.
     """
 
@@ -252,7 +253,8 @@ class Simulator:
         ``sensor="cameras"`` (the default): the object as the depth cameras of :mod:`affordplan.sim.sensor` see it,
         segmented out by geom, with range noise, dropout and holes at grazing angles; what the table, obstacles or
         the arm hide is missing; normals are estimated from the cloud. ``sensor="surface"``: an even sample of the
-        true surface with its exact normals (privileged; for ablations). Either way points touching the table are
+        surface the object's convex parts expose, with its exact outward normals (privileged; for ablations;
+        :meth:`ObjectModel.surface_samples`). Either way points touching the table are
         left out and the points are drawn with the simulator's seeded generator.
 
         Raises:

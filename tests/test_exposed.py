@@ -1,0 +1,61 @@
+"""The surface samples a pusher can touch: inner faces dropped, inward normals turned out."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from affordplan.objects.exposed import BURIED_DEPTH, depth_in_parts, exposed_samples
+from affordplan.objects.model import ObjectModel, random_object
+
+SIDE = 0.08  # metres
+
+
+def _object(mesh: trimesh.Trimesh, parts) -> ObjectModel:
+    return ObjectModel("probe", mesh, parts, mass=0.1, inertia=np.eye(3) * 1e-4)
+
+
+def _outward_ok(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Whether each normal of a sample of the centred cube of side SIDE points out of the face it lies on."""
+    axis = np.argmax(np.abs(points), axis=1)
+    rows = np.arange(len(points))
+    return np.sign(points[rows, axis]) * normals[rows, axis] > 0.99
+
+
+def test_depth_in_parts_is_positive_inside_zero_on_the_boundary_and_negative_outside():
+    cube = trimesh.creation.box(extents=(SIDE, SIDE, SIDE))
+    depth = depth_in_parts([cube], np.array([[0.0, 0.0, 0.0], [SIDE / 2, 0.0, 0.0], [SIDE, 0.0, 0.0]]))
+    assert depth == pytest.approx([SIDE / 2, 0.0, -SIDE / 2], abs=1e-9)
+
+
+def test_a_shell_inside_the_body_gets_no_samples():
+    outer = trimesh.creation.box(extents=(SIDE, SIDE, SIDE))
+    inner = trimesh.creation.box(extents=(SIDE / 2, SIDE / 2, SIDE / 2))  # a label's inner shell, say
+    obj = _object(trimesh.util.concatenate([outer, inner]), [outer])
+    points, normals = obj.surface_samples(2048, seed=0)
+    assert len(points) == 2048
+    # every sample lies on the outer cube's faces, none on the inner one
+    assert np.allclose(np.max(np.abs(points), axis=1), SIDE / 2, atol=1e-6)
+    assert _outward_ok(points, normals).all()
+    # the raw mesh would have put a fifth of them inside (the inner shell has a quarter of the outer's area)
+    raw, _ = trimesh.sample.sample_surface(obj.mesh, 2048, seed=0)
+    assert np.mean(depth_in_parts(obj.parts, raw) > BURIED_DEPTH) > 0.1
+
+
+def test_faces_wound_inwards_get_outward_normals():
+    cube = trimesh.creation.box(extents=(SIDE, SIDE, SIDE))
+    faces = cube.faces.copy()
+    faces[::2] = faces[::2, ::-1]  # every other triangle wound the wrong way, as in some scanned meshes
+    bad = trimesh.Trimesh(cube.vertices, faces, process=False)
+    raw_points, raw_idx = trimesh.sample.sample_surface(bad, 2048, seed=0)
+    assert not _outward_ok(raw_points, bad.face_normals[raw_idx]).all()  # the mesh's own normals: half inward
+    points, normals = _object(bad, [cube]).surface_samples(2048, seed=0)
+    assert _outward_ok(points, normals).all()
+
+
+def test_a_mesh_whose_surface_is_its_parts_boundary_keeps_every_sample_and_normal():
+    obj = random_object(3, "test")
+    points, face_idx = trimesh.sample.sample_surface(obj.mesh, 4096, seed=5)
+    normals = obj.mesh.face_normals[face_idx]
+    keep, turned = exposed_samples(obj.parts, points, normals)
+    assert keep.all()
+    assert np.array_equal(turned, normals)
