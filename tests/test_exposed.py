@@ -59,3 +59,13 @@ def test_a_mesh_whose_surface_is_its_parts_boundary_keeps_every_sample_and_norma
     keep, turned = exposed_samples(obj.parts, points, normals)
     assert keep.all()
     assert np.array_equal(turned, normals)
+
+
+def test_a_mesh_the_parts_do_not_expose_keeps_its_own_samples():
+    cube = trimesh.creation.box(extents=(SIDE, SIDE, SIDE))
+    inner = trimesh.creation.box(extents=(SIDE / 2, SIDE / 2, SIDE / 2))
+    obj = _object(inner, [cube])  # every point of the mesh lies 2 cm inside the parts
+    points, normals = obj.surface_samples(512, seed=0)
+    assert len(points) == 512
+    assert np.allclose(np.max(np.abs(points), axis=1), SIDE / 4, atol=1e-6)
+    assert _outward_ok(points * 2, normals).all()  # the mesh's own (outward) normals, kept

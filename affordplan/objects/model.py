@@ -115,7 +115,7 @@ class ObjectModel:
                 missing = n - len(points)
                 if missing <= 0:
                     break
-                extra, extra_normals = self._exposed_draw(int(np.ceil(missing / exposed)), seed + k)
+                extra, extra_normals = self._exposed_draw(min(int(np.ceil(missing / exposed)), 3 * n), seed + k)
                 points = np.vstack([points, extra[:missing]])
                 normals = np.vstack([normals, extra_normals[:missing]])
             if len(points) < n:  # the parts expose almost none of the mesh: its own samples, as drawn
