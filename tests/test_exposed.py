@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from affordplan.errors import InputError
 from affordplan.objects.exposed import BURIED_DEPTH, depth_in_parts, exposed_samples
 from affordplan.objects.model import ObjectModel, random_object
 
@@ -69,3 +70,9 @@ def test_a_mesh_the_parts_do_not_expose_keeps_its_own_samples():
     assert len(points) == 512
     assert np.allclose(np.max(np.abs(points), axis=1), SIDE / 4, atol=1e-6)
     assert _outward_ok(points * 2, normals).all()  # the mesh's own (outward) normals, kept
+
+
+@pytest.mark.parametrize("n, seed", [(0, 0), (-5, 0), (2.5, 0), (True, 0), (64, -1)])
+def test_surface_samples_refuse_a_count_or_seed_that_is_not_one(n, seed):
+    with pytest.raises(InputError, match="n must|seed must"):
+        random_object(3, "test").surface_samples(n, seed=seed)

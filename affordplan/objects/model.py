@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from affordplan.checks import as_finite
+from affordplan.checks import as_finite, as_seed, as_whole
 from affordplan.errors import InputError, MeshError
 from affordplan.objects import decompose, family, housekeep, repair
 from affordplan.objects.exposed import exposed_samples
@@ -32,6 +32,7 @@ from affordplan.objects.shapes import CATALOGUE, Shape
 
 DEFAULT_SIZE = 0.05  # largest half-extent, metres
 DEFAULT_DENSITY = 400.0  # kg/m^3: household objects are partly hollow
+MAX_SURFACE_SAMPLES = 1_000_000  # most points surface_samples draws (the simulator's clouds ask for 8,192)
 TOP_UP_DRAWS = 20  # uniform draws surface_samples tops its count up with before it falls back to the raw mesh
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb", ".gltf", ".off", ".dae", ".3mf")
 
@@ -102,8 +103,11 @@ class ObjectModel:
         normals wound into the parts are reversed (:mod:`affordplan.objects.exposed`), so that every point is one
         the simulated pusher can touch from where its normal points. Read-only arrays, computed once per
         ``(n, seed)`` and kept on the model.
+
+        Raises:
+            InputError: ``n`` not a whole number from 1 to ``MAX_SURFACE_SAMPLES``, or ``seed`` not a seed.
         """
-        key = (int(n), int(seed))
+        key = (as_whole("n", n, 1, MAX_SURFACE_SAMPLES), as_seed("seed", seed))
         if key not in self._samples:
             # trimesh.sample.sample_surface_even's own steps (3n uniform samples, those closer than its radius
             # dropped), without the warning it logs when fewer than n are left: those are topped up below
