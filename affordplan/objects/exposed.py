@@ -17,12 +17,17 @@ from collections.abc import Sequence
 
 import numpy as np
 import trimesh
+from scipy.spatial import cKDTree
 
 BURIED_DEPTH = 0.002  # metres inside the parts' union past which a surface sample is dropped (contact softness)
 NORMAL_PROBE = 0.003  # metres out along each side of a normal at which the parts' depth decides its orientation
 CHUNK = 2048  # points per block of the point-by-face distances (a part of a household mesh has up to ~2,000 faces)
+HOLE_RADIUS = 0.004  # metres: the parts' boundary farther than this from every kept mesh sample is a hole to fill
+HOLE_SPACINGS = 3.0  # ... or farther than this many mean sample spacings, where the samples are sparse
+SHARED_FACE = 1e-5  # metres inside another part past which a point of one part's boundary is not exposed
 
-__all__ = ["BURIED_DEPTH", "CHUNK", "NORMAL_PROBE", "depth_in_parts", "exposed_samples"]
+__all__ = ["BURIED_DEPTH", "CHUNK", "HOLE_RADIUS", "HOLE_SPACINGS", "NORMAL_PROBE", "SHARED_FACE",
+           "depth_in_parts", "exposed_boundary", "exposed_samples", "hole_fill"]
 
 
 def depth_in_parts(parts: Sequence[trimesh.Trimesh], points: np.ndarray) -> np.ndarray:
@@ -59,3 +64,70 @@ def exposed_samples(parts: Sequence[trimesh.Trimesh], points: np.ndarray,
     inward = depth_in_parts(parts, points[kept] - NORMAL_PROBE * normals[kept])
     normals[kept[(outward > 0.0) & (outward - inward > NORMAL_PROBE)]] *= -1.0
     return keep, normals
+
+
+def exposed_boundary(parts: Sequence[trimesh.Trimesh], n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """About ``n`` uniform samples of the boundary of the union of the convex ``parts`` (the parts' frame, metres)
+    and their outward unit normals: ``n`` samples spread over the parts by area, those inside another part (deeper
+    than ``SHARED_FACE``) left out. This is the surface the simulator collides and the cameras see."""
+    points, normals, part = _parts_draw(parts, n, seed)
+    keep = _outside_the_others(parts, points, part)
+    return points[keep], normals[keep]
+
+
+def hole_fill(parts: Sequence[trimesh.Trimesh], points: np.ndarray, area: float, n: int,
+              seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Samples of the parts' exposed boundary (:func:`exposed_boundary`) where ``points`` (the kept samples of a
+    mesh of ``area`` square metres, drawn ``n`` to it; the parts' frame) leave a hole, and their outward normals.
+
+    Where the parts bulge past a raw mesh, or close a cavity the mesh leaves open (a cup whose parts fill it), the
+    mesh's samples there lie buried and are dropped; the simulator still collides that surface and the cameras see
+    it. The boundary is drawn at the mesh samples' density, and a point of it counts as a hole farther than
+    ``HOLE_RADIUS`` (or ``HOLE_SPACINGS`` mean sample spacings, where these are sparse) from every kept sample:
+    wider than the gaps a uniform draw leaves. On a mesh whose surface is its parts' boundary nothing is added."""
+    parts = list(parts)
+    if not parts or n < 1 or area <= 0.0:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    density = n / area  # samples per square metre
+    boundary, normals, part = _parts_draw(parts, int(np.ceil(density * sum(p.area for p in parts))), seed)
+    if len(points):
+        radius = max(HOLE_RADIUS, HOLE_SPACINGS / np.sqrt(density))
+        far, _ = cKDTree(np.asarray(points, dtype=float)).query(boundary, distance_upper_bound=radius)
+        hole = ~np.isfinite(far)  # the cheap test first: most of the boundary lies by a mesh sample
+        boundary, normals, part = boundary[hole], normals[hole], part[hole]
+    keep = _outside_the_others(parts, boundary, part)
+    return boundary[keep], normals[keep]
+
+
+def _parts_draw(parts: Sequence[trimesh.Trimesh], n: int,
+                seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` uniform samples of the parts' surfaces together (spread by area), their outward normals and the index
+    of the part each lies on."""
+    parts = list(parts)
+    if not parts or n < 1:
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, dtype=int)
+    areas = np.array([part.area for part in parts])
+    counts = np.random.default_rng(seed).multinomial(n, areas / areas.sum())
+    points, normals, index = [], [], []
+    for i, (part, count) in enumerate(zip(parts, counts)):
+        if count == 0:
+            continue
+        hull = part.convex_hull  # outward-wound faces, as depth_in_parts takes them
+        sample, face_idx = trimesh.sample.sample_surface(hull, int(count), seed=seed + i)
+        points.append(sample)
+        normals.append(hull.face_normals[face_idx])
+        index.append(np.full(len(sample), i))
+    return np.vstack(points), np.vstack(normals), np.concatenate(index)
+
+
+def _outside_the_others(parts: Sequence[trimesh.Trimesh], points: np.ndarray, part: np.ndarray) -> np.ndarray:
+    """Whether each of ``points``, on part ``part[k]``'s boundary, lies outside every other part (within
+    ``SHARED_FACE``)."""
+    parts = list(parts)
+    keep = np.ones(len(points), dtype=bool)
+    for i in np.unique(part):
+        on = np.flatnonzero(part == i)
+        others = parts[:i] + parts[i + 1:]
+        if others:
+            keep[on] = depth_in_parts(others, points[on]) <= SHARED_FACE
+    return keep

@@ -26,7 +26,7 @@ import trimesh
 from affordplan.checks import as_finite, as_seed, as_whole
 from affordplan.errors import InputError, MeshError
 from affordplan.objects import decompose, family, housekeep, repair
-from affordplan.objects.exposed import exposed_samples
+from affordplan.objects.exposed import exposed_samples, hole_fill
 from affordplan.objects.resting import RestingState, angle_to_state, classify, compute_resting_states, yaw_period
 from affordplan.objects.shapes import CATALOGUE, Shape
 
@@ -99,10 +99,11 @@ class ObjectModel:
     def surface_samples(self, n: int = 8192, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """``n`` points spread over the surface the convex parts expose, and their outward unit normals, object frame.
 
-        The points are drawn on ``mesh``; those buried in the parts (a raw mesh's inner faces) are left out and
-        normals wound into the parts are reversed (:mod:`affordplan.objects.exposed`), so that every point is one
-        the simulated pusher can touch from where its normal points. Read-only arrays, computed once per
-        ``(n, seed)`` and kept on the model.
+        The points are drawn on ``mesh``; those buried in the parts (a raw mesh's inner faces) are left out,
+        normals wound into the parts are reversed, and where the parts bulge past the mesh or close a cavity it
+        leaves open, the parts' own boundary fills the hole (:mod:`affordplan.objects.exposed`): every point is one
+        the simulated pusher can touch from where its normal points, and no surface it collides goes unsampled.
+        Read-only arrays, computed once per ``(n, seed)`` and kept on the model.
 
         Raises:
             InputError: ``n`` not a whole number from 1 to ``MAX_SURFACE_SAMPLES``, or ``seed`` not a seed.
@@ -131,10 +132,16 @@ class ObjectModel:
         return self._samples[key]
 
     def _exposed_draw(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-        """Up to ``n`` uniform samples of ``mesh`` that the parts expose, with their outward normals."""
+        """Up to ``n`` uniform samples of ``mesh`` that the parts expose, with their outward normals, and samples
+        of the parts' boundary where those leave holes (:func:`~affordplan.objects.exposed.hole_fill`), shuffled in."""
         points, face_idx = trimesh.sample.sample_surface(self.mesh, n, seed=seed)
         keep, normals = exposed_samples(self.parts, points, self.mesh.face_normals[face_idx])
-        return points[keep], normals[keep]
+        points, normals = points[keep], normals[keep]
+        fill, fill_normals = hole_fill(self.parts, points, float(self.mesh.area), n, seed)
+        if len(fill) == 0:  # a mesh whose surface is its parts' boundary: its own samples, as drawn
+            return points, normals
+        order = np.random.default_rng(seed).permutation(len(points) + len(fill))
+        return np.vstack([points, fill])[order], np.vstack([normals, fill_normals])[order]
 
 
 def catalogue() -> list[str]:
