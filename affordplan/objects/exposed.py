@@ -7,8 +7,10 @@ privileged sample of such a mesh gives a policy contacts that no fingertip can r
 fingertip's centre lands inside the object: the approach then shoves the object before it arrives. Of 8,192
 uniform samples of each ``housekeep:validation`` mesh, 1-63 % lay more than 2 mm inside its parts.
 
-:func:`exposed_samples` keeps the samples the parts expose and turns each normal to point out of them. On a mesh
-whose surface is its parts' boundary (the procedural family, the catalogue) it keeps every sample and every normal.
+:func:`exposed_samples` keeps the samples the parts expose and turns each normal to point out of them. Where the
+parts bulge past the mesh or close a cavity it leaves open, :func:`hole_fill` samples the parts' own boundary
+(:func:`exposed_boundary`) in the holes the kept samples leave. On a mesh whose surface is its parts' boundary (the
+procedural family, the catalogue) every sample and every normal is kept and nothing is added.
 """
 
 from __future__ import annotations

@@ -132,8 +132,9 @@ class ObjectModel:
         return self._samples[key]
 
     def _exposed_draw(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-        """Up to ``n`` uniform samples of ``mesh`` that the parts expose, with their outward normals, and samples
-        of the parts' boundary where those leave holes (:func:`~affordplan.objects.exposed.hole_fill`), shuffled in."""
+        """Those of ``n`` uniform samples of ``mesh`` that the parts expose, with their outward normals, and samples
+        of the parts' boundary where those leave holes (:func:`~affordplan.objects.exposed.hole_fill`; at the same
+        density, so the draw may hold more than ``n`` where the parts' surface is larger), shuffled in."""
         points, face_idx = trimesh.sample.sample_surface(self.mesh, n, seed=seed)
         keep, normals = exposed_samples(self.parts, points, self.mesh.face_normals[face_idx])
         points, normals = points[keep], normals[keep]
