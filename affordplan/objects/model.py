@@ -113,7 +113,7 @@ class ObjectModel:
             # trimesh.sample.sample_surface_even's own steps (3n uniform samples, those closer than its radius
             # dropped), without the warning it logs when fewer than n are left: those are topped up below
             points, normals = self._exposed_draw(3 * n, seed)
-            exposed = max(len(points), 1) / (3 * n)  # the share of the mesh's area the parts expose
+            exposed = max(len(points), 1) / (3 * n)  # exposed area over the mesh area (> 1 with holes filled)
             points, keep = trimesh.points.remove_close(points, np.sqrt(exposed * self.mesh.area / (3 * n)))
             points, normals = points[:n], normals[keep][:n]
             for k in range(TOP_UP_DRAWS):  # fewer than n far enough apart: top up uniformly
@@ -123,7 +123,7 @@ class ObjectModel:
                 extra, extra_normals = self._exposed_draw(min(int(np.ceil(missing / exposed)), 3 * n), seed + k)
                 points = np.vstack([points, extra[:missing]])
                 normals = np.vstack([normals, extra_normals[:missing]])
-            if len(points) < n:  # the parts expose almost none of the mesh: its own samples, as drawn
+            if len(points) < n:  # the draws kept coming up short (next to nothing exposed): the mesh's own samples
                 points, face_idx = trimesh.sample.sample_surface(self.mesh, n, seed=seed)
                 normals = np.array(self.mesh.face_normals[face_idx])
             points.setflags(write=False)
