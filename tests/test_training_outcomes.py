@@ -8,7 +8,7 @@ import pytest
 
 from affordplan.errors import InputError
 from affordplan.objects.model import load_object, random_object
-from primitives.training.outcomes import COLUMNS, annotate, collect, main, object_of
+from primitives.training.outcomes import COLUMNS, annotate, collect, main, object_of, recorded_command
 
 
 def test_object_names_load_procedural_and_catalogue_objects():
@@ -59,3 +59,15 @@ def test_a_collection_records_every_column_with_the_start_states_drop_probabilit
     cube = load_object("cube")
     for s, prob in zip(data["state_before"], data["state_probability"]):
         assert prob == pytest.approx(cube.resting_states[int(s)].probability, rel=1e-6)
+
+
+def test_the_recorded_command_keeps_no_folder_outside_the_working_directory(tmp_path):
+    """An outcome file may ship: its recorded --out is relative inside the working directory, a bare file name
+    outside it, and left as typed when it was relative already."""
+    inside = tmp_path / "primitives" / "weights" / "push_outcome.npz"
+    outside = "/elsewhere/scratch/push_outcome.npz"
+    assert recorded_command(["collect", "push", "--out", str(inside)], cwd=tmp_path) == \
+        "python -m primitives.training.outcomes collect push --out primitives/weights/push_outcome.npz"
+    assert recorded_command(["collect", "push", f"--out={outside}", "--seed", "0"], cwd=tmp_path) == \
+        "python -m primitives.training.outcomes collect push --out=push_outcome.npz --seed 0"
+    assert recorded_command(["collect", "roll", "--out", "runs/r.npz"], cwd=tmp_path).endswith("--out runs/r.npz")

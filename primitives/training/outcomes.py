@@ -100,6 +100,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import shlex
 import sys
 import time
@@ -297,6 +298,30 @@ def check(model, data: Mapping[str, np.ndarray], lo: float = 0.1, hi: float = 0.
     return out
 
 
+def recorded_command(argv: list[str], cwd: str | os.PathLike | None = None) -> str:
+    """The command line an outcome file records: ``argv`` with an ``--out`` path made relative to ``cwd`` (default:
+    the working directory) where it lies inside it, else cut to its file name, so that no machine's own folders go
+    into a file that may ship."""
+    here = Path.cwd() if cwd is None else Path(cwd)
+    args = list(argv)
+
+    def recorded(value: str) -> str:
+        path = Path(value)
+        if not path.is_absolute():
+            return value
+        try:
+            return str(path.resolve().relative_to(here.resolve()))
+        except ValueError:
+            return path.name
+
+    for i, arg in enumerate(args):
+        if arg == "--out" and i + 1 < len(args):
+            args[i + 1] = recorded(args[i + 1])
+        elif arg.startswith("--out="):
+            args[i] = "--out=" + recorded(arg.split("=", 1)[1])
+    return "python -m primitives.training.outcomes " + shlex.join(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m primitives.training.outcomes", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
@@ -336,7 +361,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "collect" and args.out is None:
         parser.error("collect needs --out")
     torch.set_num_threads(1)
-    command = "python -m primitives.training.outcomes " + shlex.join(sys.argv[1:] if argv is None else argv)
+    command = recorded_command(sys.argv[1:] if argv is None else argv)
     model = None
     if args.command == "check":
         from primitives.outcome_model import OutcomeModel
