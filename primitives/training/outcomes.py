@@ -123,6 +123,7 @@ from primitives import params as skill_params
 from primitives.params import PUSH_STEP, SKILLS, SPIN_MAX, SPIN_MIN, made_progress
 from primitives.skills import Skill, load_skills, skills_sensor
 from primitives.training.env import EnvConfig, _lru, object_groups
+from primitives.training.provenance import recorded_path
 
 COLUMNS = {  # name: dtype
     "p": np.float32, "param": np.float32, "success": bool, "made_progress": bool, "progress": np.float32,
@@ -299,26 +300,16 @@ def check(model, data: Mapping[str, np.ndarray], lo: float = 0.1, hi: float = 0.
 
 
 def recorded_command(argv: list[str], cwd: str | os.PathLike | None = None) -> str:
-    """The command line an outcome file records: ``argv`` with an ``--out`` path made relative to ``cwd`` (default:
-    the working directory) where it lies inside it, else cut to its file name, so that no machine's own folders go
-    into a file that may ship."""
-    here = Path.cwd() if cwd is None else Path(cwd)
+    """The command line an outcome file records: ``argv`` with its ``--out`` path as
+    :func:`primitives.training.provenance.recorded_path` records it (relative to ``cwd``, default the working
+    directory, where it lies inside it, else its file name), so that no machine's own folders go into a file that may
+    ship."""
     args = list(argv)
-
-    def recorded(value: str) -> str:
-        path = Path(value)
-        if not path.is_absolute():
-            return value
-        try:
-            return str(path.resolve().relative_to(here.resolve()))
-        except ValueError:
-            return path.name
-
     for i, arg in enumerate(args):
         if arg == "--out" and i + 1 < len(args):
-            args[i + 1] = recorded(args[i + 1])
+            args[i + 1] = recorded_path(args[i + 1], cwd)
         elif arg.startswith("--out="):
-            args[i] = "--out=" + recorded(arg.split("=", 1)[1])
+            args[i] = "--out=" + recorded_path(arg.split("=", 1)[1], cwd)
     return "python -m primitives.training.outcomes " + shlex.join(args)
 
 

@@ -66,6 +66,7 @@ from primitives.option_ranker import (
 from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.evaluate import load_policy
 from primitives.training.options import execute_every_option
+from primitives.training.provenance import recorded_path, recorded_paths
 from primitives.training.success import (
     SuccessModel,
     auroc,
@@ -258,9 +259,10 @@ def fit(skill: str, folders: list[str | Path], out: str | Path, seed: int = 0, e
                    train=pick_figures(ranker.score(x[~held]), y[~held], starts[~held]))
     if refit:
         ranker, _ = _train(x, y, best_epoch, width, members, weight_decay, seed, progress, f"{skill} refit")
-    info = dict(command=" ".join(["python -m primitives.training.ranker fit", skill, *map(str, folders), "--out",
-                                  str(out), "--seed", str(seed), "--epochs", str(epochs), "--width", str(width),
-                                  "--members", str(members), *([] if refit else ["--no-refit"])]),
+    info = dict(command=" ".join(["python -m primitives.training.ranker fit", skill, *recorded_paths(folders),
+                                  "--out", recorded_path(out), "--seed", str(seed), "--epochs", str(epochs),
+                                  "--width", str(width), "--members", str(members),
+                                  *([] if refit else ["--no-refit"])]),
                 starts=int(len(ids)), options=int(len(y)), epoch=best_epoch, members=members, refit=refit,
                 sensor=sensor, minutes=round((time.perf_counter() - t0) / 60.0, 2), **figures)
     save_ranker(out, ranker, skill, sensor, info)
@@ -304,7 +306,7 @@ def calibrate(skill: str, out: str | Path, rollouts: int = 2400, objects: str = 
                 command=f"python -m primitives.training.ranker calibrate {skill} --rollouts {rollouts} --seed {seed}"
                         + (f" --workers {workers}" if workers > 1 else "")
                         + (f" --objects {objects}" if objects != "train+housekeep:training" else "")
-                        + (f" --frames {frames}" if frames != "shipped" else "")
+                        + (f" --frames {recorded_path(frames)}" if frames != "shipped" else "")
                         + (f" --sensor {sensor}" if sensor != "cameras" else ""))
     calibrated = replace(calibrated, info=dict(search.info, ranker_calibration=info))
     beside = rating_path(skill, "frames", sensor) if frames == "shipped" else Path(frames)  # where its ranker is

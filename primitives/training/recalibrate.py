@@ -33,6 +33,7 @@ from primitives import weights_file
 from primitives.frames import load_frame_search
 from primitives.success_model import SuccessModel, SuccessNet, load_success_net
 from primitives.training.env import PRIMITIVES, check_objects
+from primitives.training.provenance import recorded_path
 from primitives.training.success import Rollouts, _platt, collect_frame_search, metrics, save
 
 MIN_OBJECTS = 2  # a leave-one-object-out estimate needs another object to fit on
@@ -143,14 +144,14 @@ def run(args: argparse.Namespace) -> int:
     platt_before = [float(v) for v in net.platt]
     net.platt.copy_(torch.tensor(result.platt))
     info = dict(skill=args.skill, sensor=args.sensor, objects=args.objects, rollouts=len(data), seed=args.seed,
-                frames=args.frames, searched=str(searched_path), platt_before=platt_before,
+                frames=recorded_path(args.frames), searched=recorded_path(searched_path), platt_before=platt_before,
                 objects_seen=int(len(np.unique(data.group))), **result.report(data.success),
                 command=" ".join(["python -m primitives.training.recalibrate", args.skill, "--objects", args.objects,
                                   "--sensor", args.sensor, "--rollouts", str(args.rollouts), "--seed",
-                                  str(args.seed), "--out", str(args.out),
-                                  *(["--frames", args.frames] if args.frames != "shipped" else []),
-                                  *(["--searched", args.searched] if args.searched else []),
-                                  *(["--policy", args.policy] if args.policy else [])]))
+                                  str(args.seed), "--out", recorded_path(args.out),
+                                  *(["--frames", recorded_path(args.frames)] if args.frames != "shipped" else []),
+                                  *(["--searched", recorded_path(args.searched)] if args.searched else []),
+                                  *(["--policy", recorded_path(args.policy)] if args.policy else [])]))
     save(net, out / "success_searched.pt", info)
     (out / "calibrate.json").write_text(json.dumps(info, indent=2))
     print(json.dumps(info, indent=2))

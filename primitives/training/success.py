@@ -73,6 +73,7 @@ from primitives.success_model import (  # noqa: F401 (re-exported for training a
 )
 from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.neighbours import neighbour_outcomes
+from primitives.training.provenance import recorded_path, recorded_paths
 
 
 # --------------------------------------------------------------------------------- data
@@ -771,27 +772,29 @@ def _run(args: argparse.Namespace) -> int:
         net, info = fit(data, seed=args.seed, epochs=args.epochs, members=args.members, progress=not args.json,
                         views=views, encoder=args.encoder, rank_weight=args.rank_weight)
         info.update(skill=args.skill, rollouts=len(data) if args.rollouts_from else args.rollouts, seed=args.seed,
-                    workers=args.workers, policy=args.policy or "shipped", objects=args.objects, sensor=args.sensor,
-                    full_motion=args.full_motion)
+                    workers=args.workers, policy=recorded_path(args.policy or "shipped"), objects=args.objects,
+                    sensor=args.sensor, full_motion=args.full_motion)
         if args.rollouts_from:
-            info.update(rollouts_from=args.rollouts_from)
+            info.update(rollouts_from=recorded_paths(args.rollouts_from))
         if searched:
-            info.update(frames=args.frames, model=args.model or "shipped")
+            info.update(frames=recorded_path(args.frames), model=recorded_path(args.model or "shipped"))
         if args.contrast:
             info.update(contrast=args.contrast, contrast_stand_ins=args.contrast_stand_ins, neighbours=args.neighbours)
         info["command"] = ("python -m primitives.success train " + args.skill
-                           + (f" --policy {args.policy}" if args.policy else "")
+                           + (f" --policy {recorded_path(args.policy)}" if args.policy else "")
                            + ("" if args.rollouts_from else f" --rollouts {args.rollouts}")
                            + f" --seed {args.seed} --epochs {args.epochs} --members {args.members}"
                            + (f" --contrast {args.contrast}" if args.contrast else "")
                            + (f" --contrast-stand-ins {args.contrast_stand_ins}" if args.contrast_stand_ins else "")
                            + (" --neighbours" if args.neighbours else "")
-                           + (f" --frames {args.frames}" if searched else "") + (" --views" if views else "")
-                           + (f" --model {args.model}" if searched and args.model else "")
+                           + (f" --frames {recorded_path(args.frames)}" if searched else "")
+                           + (" --views" if views else "")
+                           + (f" --model {recorded_path(args.model)}" if searched and args.model else "")
                            + (f" --workers {args.workers}" if args.workers > 1 else "")
                            + (f" --encoder {args.encoder}" if args.encoder != "cloud" else "")
                            + (f" --rank-weight {args.rank_weight:g}" if args.rank_weight else "")
-                           + (" --rollouts-from " + " ".join(args.rollouts_from) if args.rollouts_from else "")
+                           + (" --rollouts-from " + " ".join(recorded_paths(args.rollouts_from))
+                              if args.rollouts_from else "")
                            + _objects_args(args))
         save(net, out / "success.pt", info)
         print(json.dumps(info, indent=2))
@@ -847,8 +850,8 @@ def _run_frames(args: argparse.Namespace) -> int:
     search = replace(search, platt=platt, platt_unparameterised=platt_seed)
     p = search.calibrate(rating, par)
     info = dict(skill=args.skill, rollouts=args.rollouts, seed=args.seed, workers=args.workers,
-                policy=args.policy or "shipped", objects=args.objects, sensor=args.sensor,
-                model=args.model or "shipped", frames_parameterised=len(search.frames(args.skill, {})),
+                policy=recorded_path(args.policy or "shipped"), objects=args.objects, sensor=args.sensor,
+                model=recorded_path(args.model or "shipped"), frames_parameterised=len(search.frames(args.skill, {})),
                 frames_seed_objective=len(search.frames(args.skill, None)),
                 success_rate=float(success.mean()), parameterised=int(par.sum()), raw=metrics(rating, success),
                 calibrated=metrics(p, success), calibrated_parameterised=metrics(p[par], success[par]))
@@ -865,8 +868,8 @@ def _run_frames(args: argparse.Namespace) -> int:
                     stand_in_calibrated=metrics(search.calibrate(score, False), seed_data.success))
     info.update(minutes=(time.perf_counter() - t0) / 60,
                 command=f"python -m primitives.success frames {args.skill}"
-                        f"{f' --policy {args.policy}' if args.policy else ''}"
-                        f"{f' --model {args.model}' if args.model else ''} --turns {args.turns}"
+                        f"{f' --policy {recorded_path(args.policy)}' if args.policy else ''}"
+                        f"{f' --model {recorded_path(args.model)}' if args.model else ''} --turns {args.turns}"
                         f"{' --mirror' if args.mirror else ''} --rollouts {args.rollouts}"
                         + (f" --stand-ins {args.stand_ins} --stand-in-rollouts {args.stand_in_rollouts}"
                            if args.stand_ins else "") +
