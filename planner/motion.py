@@ -52,6 +52,7 @@ PRISM_HEIGHT = 0.2  # z extent (metres) shared by the footprint prism and the ob
 MAX_STEP = 0.01  # metres between consecutive states of a returned path
 MAX_TURN = math.radians(5.0)  # radians between consecutive states of a returned path
 BROAD_PHASE_SLACK = 1e-6  # metres added to the footprint's radius before a box is skipped unchecked
+SOLVE_ITERATIONS = 5000  # RRT-Connect iterations per SE(2) attempt (plan_path): 0.1-0.3 s unloaded here
 
 
 def _prism(polygon: np.ndarray, height: float) -> fcl.Convex:
@@ -375,15 +376,7 @@ def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *
                 state[0], state[1] = float(xy[0]), float(xy[1])
                 ends.append(state)
             setup.setStartAndGoalStates(*ends)
-            count = [0]
-
-            def spent() -> bool:
-                count[0] += 1
-                return count[0] > iterations
-
-            ptc = ob.plannerOrTerminationCondition(ob.PlannerTerminationCondition(spent),
-                                                   ob.timedPlannerTerminationCondition(time_limit))
-            result = setup.solve(ptc)
+            result = setup.solve(_budget(iterations, time_limit))
             if result.getStatus() != ob.PlannerStatus.EXACT_SOLUTION or not setup.haveExactSolutionPath():
                 return None
             setup.simplifySolution(0.0)  # 0: simplify to the end (no time limit, so deterministic)
@@ -394,6 +387,20 @@ def plan_at_held_yaw(checker: FootprintChecker, start_xy, goal_xy, yaw: float, *
         del planner, setup
     xy[0], xy[-1] = start_xy, goal_xy
     return xy
+
+
+def _budget(iterations: int, seconds: float) -> ob.PlannerTerminationCondition:
+    """Stop a solve after ``iterations`` checks of the condition (RRT-Connect checks it once per iteration), or, as
+    a safeguard on a slow machine, after ``seconds``: the same seed then gives the same answer however loaded the
+    machine is, as long as the safeguard does not fire."""
+    count = [0]
+
+    def spent() -> bool:
+        count[0] += 1
+        return count[0] > iterations
+
+    return ob.plannerOrTerminationCondition(ob.PlannerTerminationCondition(spent),
+                                            ob.timedPlannerTerminationCondition(seconds))
 
 
 def _turn_once(checker: FootprintChecker, start, goal, *, time_limit: float, seed: int,
@@ -451,15 +458,17 @@ def plan_path(
     resolution: float = 0.005,
     yaw_weight: float = 0.05,
     attempts: int = 1,
+    iterations: int = SOLVE_ITERATIONS,
     single_turn: bool = True,
     turn_first: bool = True,
 ) -> np.ndarray:
     """Collision-free SE(2) path of the checker's footprint from ``start`` to ``goal``.
 
     RRT-Connect (OMPL) on ``SE2StateSpace`` bounded by the workspace, motions checked every
-    ``resolution`` of SE(2) distance, then OMPL's simplifier, then subdivision to steps of at most
-    1 cm and 5 deg. Every returned state, and every state OMPL checked along the simplified path, is
-    re-checked with ``checker.is_free``.
+    ``resolution`` of SE(2) distance, then OMPL's simplifier (run until it improves nothing more), then subdivision
+    to steps of at most 1 cm and 5 deg. Each attempt is bounded by ``iterations``, not by time, so the same seed
+    gives the same path however loaded the machine is; ``time_limit`` is a safeguard for a slow machine. Every
+    returned state, and every state OMPL checked along the simplified path, is re-checked with ``checker.is_free``.
 
     With ``single_turn`` (the default), paths turn once, in place (:func:`single_turn_path`), wherever that
     is free: the straight way is returned without sampling when it is free, and a sampled path's positions
@@ -467,17 +476,19 @@ def plan_path(
 
     RRT-Connect is not optimising and the simplifier keeps a path's homotopy class, so a path may turn
     a full extra revolution (e.g. pass a gap at yaw + pi): with ``attempts > 1`` the planner restarts
-    while time is left and keeps the shortest solution (:func:`path_length`).
+    (while ``time_limit`` is not spent) and keeps the shortest solution (:func:`path_length`).
 
     Args:
         checker: footprint, obstacles and workspace.
         start, goal: (x, y, yaw) of the object-centred origin, world frame, metres and radians.
-        time_limit: seconds for all solver attempts together (simplifying takes at least 20 ms more).
+        time_limit: seconds after which no further solve starts and a running one stops (a safeguard:
+            unloaded, ``iterations`` binds first).
         seed: seeds OMPL's process-global seed generator (see the module docstring); the same seed,
-            problem and OMPL build give the same path when the solver finishes within ``time_limit``.
+            problem and OMPL build give the same path unless ``time_limit`` cut a solve short.
         resolution: SE(2) distance between checked states along a motion, metres-equivalent.
         yaw_weight: metres that one radian of yaw counts for in the SE(2) metric.
         attempts: independent RRT-Connect runs; the shortest exact solution is returned.
+        iterations: RRT-Connect iterations each attempt may take.
         single_turn: prefer paths that turn once (:func:`single_turn_path`).
         turn_first: with ``single_turn``, try turning at the start before turning at the goal.
 
@@ -488,7 +499,7 @@ def plan_path(
     Raises:
         InputError: a malformed argument (NaN, wrong shape, non-positive limits).
         GoalError: the start or the goal is not free; the message says why.
-        PlanningError: no exact solution within ``time_limit``.
+        PlanningError: no exact solution within ``iterations`` per attempt (or ``time_limit``).
     """
     if not isinstance(checker, FootprintChecker):
         raise InputError(f"checker must be a FootprintChecker, got {type(checker).__name__}")
@@ -501,6 +512,8 @@ def plan_path(
         raise InputError(f"seed must be an int in [0, 2**32 - 1), got {seed!r}")
     if not is_whole(attempts) or attempts < 1:
         raise InputError(f"attempts must be an int >= 1, got {attempts!r}")
+    if not is_whole(iterations) or iterations < 1:
+        raise InputError(f"iterations must be an int >= 1, got {iterations!r}")
     for name, pose in (("start", start), ("goal", goal)):
         reason = checker.why_not_free(*pose)
         if reason is not None:
@@ -528,11 +541,11 @@ def plan_path(
                     break
                 if attempt:
                     setup.clear()  # forget the trees and the solution; start and goal stay
-                result = setup.solve(remaining)
+                result = setup.solve(_budget(int(iterations), remaining))
                 status = result.asString()
                 if result.getStatus() != ob.PlannerStatus.EXACT_SOLUTION or not setup.haveExactSolutionPath():
                     continue  # approximate solutions count as failures
-                setup.simplifySolution(max(0.02, deadline - time.perf_counter()))
+                setup.simplifySolution(0.0)  # 0: simplify to the end (no time limit, so deterministic)
                 waypoints, counts = _solution(space, setup)
                 length = path_length(waypoints, yaw_weight)
                 if best is None or length < best[0]:
@@ -540,8 +553,8 @@ def plan_path(
     finally:
         del planner, setup  # nanobind reports "leaked" objects at exit otherwise
     if best is None:
-        raise PlanningError(f"no collision-free path from {start} to {goal} within {time_limit:.3g} s "
-                            f"(OMPL: {status})")
+        raise PlanningError(f"no collision-free path from {start} to {goal} within {int(attempts)} x "
+                            f"{int(iterations)} RRT-Connect iterations or {time_limit:.3g} s (OMPL: {status})")
 
     _, waypoints, counts = best
     waypoints[0] = (start[0], start[1], wrap_angle(start[2]))

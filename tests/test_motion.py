@@ -205,6 +205,29 @@ def test_same_seed_same_path(wall_checker, single_turn):
     assert np.array_equal(a, b)
 
 
+class _SlowChecker(FootprintChecker):
+    """The same scene, each state check slowed as on a loaded machine."""
+
+    def is_free(self, x: float, y: float, yaw: float) -> bool:
+        deadline = time.perf_counter() + 2e-5
+        while time.perf_counter() < deadline:
+            pass
+        return super().is_free(x, y, yaw)
+
+
+def test_a_slower_machine_gets_the_same_sampled_path(cube_footprint, wall_checker):
+    """The SE(2) solve is bounded by iterations, not seconds: checks that take longer change nothing."""
+    fast = plan_path(wall_checker, START, GOAL, seed=5, attempts=2, single_turn=False)
+    slow = plan_path(_SlowChecker(cube_footprint, WALL, WORKSPACE), START, GOAL, seed=5, attempts=2,
+                     single_turn=False)
+    assert np.array_equal(fast, slow)
+
+
+def test_an_iteration_budget_too_small_to_pass_the_gap_raises(wall_checker):
+    with pytest.raises(PlanningError, match="2 x 3 RRT-Connect iterations"):
+        plan_path(wall_checker, START, GOAL, seed=0, attempts=2, iterations=3, single_turn=False)
+
+
 def test_restarts_keep_the_shortest_path(wall_checker):
     one = plan_path(wall_checker, START, GOAL, seed=4, single_turn=False)  # the sampled SE(2) way
     best = plan_path(wall_checker, START, GOAL, seed=4, attempts=3, single_turn=False)
@@ -236,6 +259,8 @@ def test_inputs_are_validated(wall_checker):
         plan_path(wall_checker, START, GOAL, time_limit=float("nan"))
     with pytest.raises(InputError):
         plan_path(wall_checker, START, GOAL, seed=-1)
+    with pytest.raises(InputError):
+        plan_path(wall_checker, START, GOAL, iterations=0)
     with pytest.raises(InputError):
         FootprintChecker(np.array([[0.0, 0.0], [1.0, np.nan], [0.0, 1.0]]))
 
