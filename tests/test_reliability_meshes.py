@@ -7,7 +7,6 @@ and settles the object in its first resting state. Bad files are written into ``
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import numpy as np
@@ -176,15 +175,12 @@ def test_scales_from_a_millimetre_to_a_kilometre_load_the_same_object(tmp_path, 
 
 
 @pytest.mark.slow
-def test_a_million_faces_load_decimated_in_seconds(tmp_path):
+def test_a_million_faces_load_decimated(tmp_path):
     sphere = trimesh.creation.icosphere(subdivisions=8)  # 1,310,720 faces
     sphere.apply_scale([1.0, 0.7, 0.5])
     path = tmp_path / "ellipsoid.ply"
     sphere.export(path)
-    t0 = time.perf_counter()
     obj, messages = load_quietly(path)
-    elapsed = time.perf_counter() - t0
-    assert elapsed < 20.0
     assert any("1310720 faces; decimated to" in m for m in messages)
     assert len(obj.mesh.faces) <= repair.DECIMATED_FACES
     assert len(obj.hull.faces) <= repair.MAX_HULL_FACES + 10
