@@ -189,6 +189,21 @@ def test_pool_reports_over_the_tasks_of_every_run(tmp_path):
     assert (tmp_path / "bench.png").stat().st_size > 10_000
 
 
+def test_runs_of_one_seed_by_different_planners_pool_side_by_side():
+    """`bench plan --planner affordplan` and `--planner greedy`, saved apart, pool into one report of both."""
+    from affordplan.app.bench.plan import pool
+
+    both = _saved_run(4, [True, False, True], [0.9, 0.3, 0.7])
+    ours = dict(both, tasks=[t for t in both["tasks"] if t["planner"] == "affordplan"])
+    greedy = dict(both, tasks=[t for t in both["tasks"] if t["planner"] == "greedy"])
+    report = pool([ours, greedy])
+    assert report.planners == ["affordplan", "greedy"]
+    assert report.summary("affordplan")["success"] == pytest.approx(2 / 3)
+    assert report.summary("greedy")["success"] == pytest.approx(1 / 3)
+    with pytest.raises(InputError, match=r"seed 4 \(greedy\)"):
+        pool([ours, greedy, greedy])
+
+
 def test_pool_refuses_runs_that_are_not_one_bench():
     from affordplan.app.bench.plan import pool
 

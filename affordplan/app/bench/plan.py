@@ -426,7 +426,8 @@ def pool(reports: Sequence[dict]) -> BenchReport:
 
     Raises:
         InputError: no runs, a run that is not a saved plan bench, runs that differ in their execution budget,
-            objects or draw (their tasks would not be one bench), or two runs of one seed.
+            objects or draw (their tasks would not be one bench), or two runs of one seed by the same planner (runs
+            of one seed by different planners, e.g. ``--planner greedy`` beside affordplan, pool side by side).
     """
     if not reports:
         raise InputError("no bench runs to pool")
@@ -437,7 +438,7 @@ def pool(reports: Sequence[dict]) -> BenchReport:
         try:
             kinds.add((int(report["max_primitives"]), str(report["objects"]), int(report.get("draw", 0))))
             if report.get("seed") is not None:  # runs saved before 0.24 carry no seed
-                seeds.append(int(report["seed"]))
+                seeds += [(name, int(report["seed"])) for name in sorted({t["planner"] for t in report["tasks"]})]
             for task in report["tasks"]:
                 task = {k: v for k, v in task.items() if k in known}
                 task["steps"] = [tuple(step) for step in task.get("steps", [])]
@@ -449,7 +450,8 @@ def pool(reports: Sequence[dict]) -> BenchReport:
                          + "; ".join(f"budget {b}, objects {o}, draw {d}" for b, o, d in sorted(kinds)))
     twice = sorted({s for s in seeds if seeds.count(s) > 1})
     if twice:
-        raise InputError(f"runs of the same seed given twice: {twice}")
+        raise InputError("runs of the same seed and planner given twice: "
+                         + ", ".join(f"seed {seed} ({name})" for name, seed in twice))
     (budget, objects, draw), = kinds
     return BenchReport(results=results, draw=draw, objects=objects, max_primitives=budget)
 
