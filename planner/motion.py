@@ -408,7 +408,8 @@ def _turn_once(checker: FootprintChecker, start, goal, *, time_limit: float, see
     """A path that turns once, in place, at the start or at the goal, and moves at one held yaw (or ``None``).
 
     The straight way first (:func:`single_turn_path`), then a plane path at the goal's yaw after turning at
-    the start, then one at the start's yaw before turning at the goal (:func:`plan_at_held_yaw`).
+    the start, then one at the start's yaw before turning at the goal (:func:`plan_at_held_yaw`, each bounded by its
+    iterations; ``time_limit`` is each one's safeguard on a slow machine).
     """
     path = single_turn_path(checker, np.array([start, goal], dtype=float), resolution, turn_first)
     if path is not None:
@@ -519,7 +520,7 @@ def plan_path(
         if reason is not None:
             raise GoalError(f"{name} {pose} is not free: {reason}")
     if single_turn:
-        path = _turn_once(checker, start, goal, time_limit=time_limit / 4, seed=int(seed), resolution=resolution,
+        path = _turn_once(checker, start, goal, time_limit=time_limit, seed=int(seed), resolution=resolution,
                           turn_first=turn_first)
         if path is not None:
             return path
