@@ -72,6 +72,7 @@ from primitives.networks import HybridActorCritic
 from primitives.training import checkpoint as ckpt
 from primitives.training.env import PRIMITIVES, EnvConfig, PrimitiveEnv, check_objects
 from primitives.training.hindsight import relabel
+from primitives.training.provenance import recorded_path
 from primitives.training.replay import ReplayBuffer
 from primitives.training.rollouts import BACKENDS, Exploration, act, import_ray, make_source, rss_mb
 
@@ -327,7 +328,8 @@ def _train_locked(cfg: TrainConfig, out: Path, resume: bool, progress: bool) -> 
         gen.set_state(saved["gen"])
         state.update(saved["state"])
         del saved  # its replay copy (~250 MB for 50,000 clouds) is in the buffer now; holding it would add that much
-    (out / "config.json").write_text(json.dumps(asdict(cfg), indent=2))
+    recorded = dict(asdict(cfg), out=recorded_path(cfg.out), init=cfg.init and recorded_path(cfg.init))
+    (out / "config.json").write_text(json.dumps(recorded, indent=2))  # it ships beside the weights: no machine paths
 
     env, source = None, None
     explore = exploration(cfg)
